@@ -1,0 +1,148 @@
+"""Build the bundled Cornell box scenes in Blender and export them with Blender's own glTF exporter.
+
+Run from the repository root with the PyPI `bpy` package (Blender as a Python module):
+
+    pip install bpy==5.0.1
+    python3 tools/blender/make_cornell.py
+
+Writes `assets/cornell_box.glb` (two diffuse boxes) and `assets/cornell_spheres.glb`
+(a mirror sphere and a glass sphere). Blender is Z-up; the exporter converts to glTF's Y-up.
+The wall colours are the usual Cornell box reflectances; the light is a small emissive quad
+just below the ceiling, exported through KHR_materials_emissive_strength.
+"""
+
+import math
+import os
+import sys
+
+import bpy
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ASSETS = os.path.join(ROOT, "assets")
+
+WHITE = (0.725, 0.71, 0.68)
+RED = (0.63, 0.065, 0.05)
+GREEN = (0.14, 0.45, 0.091)
+LIGHT_COLOUR = (1.0, 0.85, 0.6)
+LIGHT_STRENGTH = 12.0
+
+
+def reset():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.resolution_x = 512
+    scene.render.resolution_y = 512
+    return scene
+
+
+def principled(name, colour, metallic=0.0, roughness=1.0, transmission=0.0, ior=1.5,
+               emission=None, strength=0.0):
+    """A Principled BSDF material; its inputs are what Blender's glTF exporter reads."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (*colour, 1.0)
+    bsdf.inputs["Metallic"].default_value = metallic
+    bsdf.inputs["Roughness"].default_value = roughness
+    bsdf.inputs["Transmission Weight"].default_value = transmission
+    bsdf.inputs["IOR"].default_value = ior
+    if emission is not None:
+        bsdf.inputs["Emission Color"].default_value = (*emission, 1.0)
+        bsdf.inputs["Emission Strength"].default_value = strength
+    return mat
+
+
+def mesh_object(name, verts, faces, material, smooth=False):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(verts, [], faces)
+    mesh.update()
+    for poly in mesh.polygons:
+        poly.use_smooth = smooth
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def quad(name, corners, material):
+    """A single quad; corners are listed so that the normal faces into the box."""
+    return mesh_object(name, corners, [(0, 1, 2, 3)], material)
+
+
+def box(name, material, size, location, angle_deg):
+    """An axis-aligned box of `size` (x, y, z) standing on the floor, turned about Z."""
+    sx, sy, sz = (s / 2 for s in size)
+    verts = [(x, y, z) for z in (0.0, 2 * sz) for y in (-sy, sy) for x in (-sx, sx)]
+    faces = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    obj = mesh_object(name, verts, faces, material)
+    obj.location = location
+    obj.rotation_euler = (0.0, 0.0, math.radians(angle_deg))
+    return obj
+
+
+def sphere(name, material, radius, location):
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=radius, location=location)
+    obj = bpy.context.active_object
+    obj.name = name
+    bpy.ops.object.shade_smooth()
+    obj.data.materials.append(material)
+    return obj
+
+
+def cornell_shell(scene):
+    """Floor, ceiling, back wall, red left wall, green right wall, ceiling light and camera."""
+    white = principled("White", WHITE)
+    red = principled("Red", RED)
+    green = principled("Green", GREEN)
+    light = principled("Light", (0.78, 0.78, 0.78), emission=LIGHT_COLOUR, strength=LIGHT_STRENGTH)
+    quad("Floor", [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], white)
+    quad("Ceiling", [(-1, -1, 2), (-1, 1, 2), (1, 1, 2), (1, -1, 2)], white)
+    quad("BackWall", [(-1, 1, 0), (1, 1, 0), (1, 1, 2), (-1, 1, 2)], white)
+    quad("LeftWall", [(-1, -1, 0), (-1, 1, 0), (-1, 1, 2), (-1, -1, 2)], red)
+    quad("RightWall", [(1, -1, 0), (1, -1, 2), (1, 1, 2), (1, 1, 0)], green)
+    s = 0.25
+    quad("CeilingLight", [(-s, -s, 1.98), (-s, s, 1.98), (s, s, 1.98), (s, -s, 1.98)], light)
+
+    cam_data = bpy.data.cameras.new("Camera")
+    cam_data.lens_unit = "FOV"
+    cam_data.angle = math.radians(39.3)
+    cam = bpy.data.objects.new("Camera", cam_data)
+    cam.location = (0.0, -3.9, 1.0)
+    cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    return white
+
+
+def export(path):
+    bpy.ops.export_scene.gltf(
+        filepath=path,
+        export_format="GLB",
+        export_cameras=True,
+        export_yup=True,
+        export_apply=True,
+    )
+    print(f"wrote {path} ({os.path.getsize(path)} bytes)")
+
+
+def main():
+    os.makedirs(ASSETS, exist_ok=True)
+
+    scene = reset()
+    white = cornell_shell(scene)
+    box("TallBox", white, (0.6, 0.6, 1.2), (-0.33, 0.3, 0.0), 17.0)
+    box("ShortBox", white, (0.6, 0.6, 0.6), (0.35, -0.3, 0.0), -17.0)
+    export(os.path.join(ASSETS, "cornell_box.glb"))
+
+    scene = reset()
+    cornell_shell(scene)
+    mirror = principled("Mirror", (0.95, 0.95, 0.95), metallic=1.0, roughness=0.0)
+    glass = principled("Glass", (1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5)
+    sphere("MirrorSphere", mirror, 0.4, (-0.45, 0.35, 0.4))
+    sphere("GlassSphere", glass, 0.4, (0.45, -0.3, 0.4))
+    export(os.path.join(ASSETS, "cornell_spheres.glb"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
