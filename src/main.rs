@@ -1,3 +1,5 @@
+//! The `gridtrace` command: render a scene file to an image.
+
 fn main() {
-    println!("Hello, world!");
+    std::process::exit(gridtrace::cli::main());
 }

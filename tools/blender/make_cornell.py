@@ -7,8 +7,8 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
 
 Writes `assets/cornell_box.glb` (two diffuse boxes) and `assets/cornell_spheres.glb`
 (a mirror sphere and a glass sphere). Blender is Z-up; the exporter converts to glTF's Y-up.
-The wall colours are the usual Cornell box reflectances; the light is a small emissive quad
-just below the ceiling, exported through KHR_materials_emissive_strength.
+The wall colours are the usual Cornell box reflectances; the light is an emissive quad that
+fills an opening in the ceiling, exported through KHR_materials_emissive_strength.
 """
 
 import math
@@ -96,12 +96,21 @@ def cornell_shell(scene):
     green = principled("Green", GREEN)
     light = principled("Light", (0.78, 0.78, 0.78), emission=LIGHT_COLOUR, strength=LIGHT_STRENGTH)
     quad("Floor", [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], white)
-    quad("Ceiling", [(-1, -1, 2), (-1, 1, 2), (1, 1, 2), (1, -1, 2)], white)
+    # The ceiling is a ring around an opening that the light fills: a light hanging below
+    # a closed ceiling would light a hidden strip above itself, which paths find only by
+    # chance (fireflies), and Cycles emits from both faces of a mesh light.
+    s = 0.25
+    ring = [
+        [(-1, -1, 2), (-1, 1, 2), (-s, 1, 2), (-s, -1, 2)],
+        [(s, -1, 2), (s, 1, 2), (1, 1, 2), (1, -1, 2)],
+        [(-s, -1, 2), (-s, -s, 2), (s, -s, 2), (s, -1, 2)],
+        [(-s, s, 2), (-s, 1, 2), (s, 1, 2), (s, s, 2)],
+    ]
+    mesh_object("Ceiling", [v for q in ring for v in q], [(4 * i, 4 * i + 1, 4 * i + 2, 4 * i + 3) for i in range(4)], white)
     quad("BackWall", [(-1, 1, 0), (1, 1, 0), (1, 1, 2), (-1, 1, 2)], white)
     quad("LeftWall", [(-1, -1, 0), (-1, 1, 0), (-1, 1, 2), (-1, -1, 2)], red)
     quad("RightWall", [(1, -1, 0), (1, -1, 2), (1, 1, 2), (1, 1, 0)], green)
-    s = 0.25
-    quad("CeilingLight", [(-s, -s, 1.98), (-s, s, 1.98), (s, s, 1.98), (s, -s, 1.98)], light)
+    quad("CeilingLight", [(-s, -s, 2), (-s, s, 2), (s, s, 2), (s, -s, 2)], light)
 
     cam_data = bpy.data.cameras.new("Camera")
     cam_data.lens_unit = "FOV"

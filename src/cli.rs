@@ -1,0 +1,266 @@
+//! The command-line driver: parse arguments, load, render, write. Errors exit with code 2.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, anyhow, bail};
+use clap::Parser;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use crate::load::load_scene;
+use crate::output::{check_writable, write_image};
+use crate::render::{RenderSettings, Renderer, Strategy};
+use crate::scene::{Camera, Scene};
+
+/// Image height used when neither --width nor --height is given.
+const DEFAULT_HEIGHT: u32 = 512;
+
+/// Render a glTF 2.0 scene (.gltf, .glb) with a physically based path tracer.
+///
+/// Emissive materials are area lights; metallic materials are ideal mirrors; transmissive
+/// materials are ideal glass; everything else is Lambertian. Output is linear float
+/// OpenEXR (.exr) or 8-bit sRGB PNG (.png), chosen by the output file's extension.
+#[derive(Parser, Debug)]
+#[command(name = "gridtrace", version, about, long_about)]
+pub struct Args {
+    /// Scene file to render (.gltf or .glb).
+    pub scene: PathBuf,
+
+    /// Output image, .exr (linear float RGBA) or .png (sRGB). [default: SCENE_STEM.exr in the current folder]
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+
+    /// Samples per pixel: more means less noise and a longer render.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: u32,
+
+    /// Image width in pixels. [default: from --height and the camera's aspect ratio]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub width: Option<u32>,
+
+    /// Image height in pixels. [default: 512, or from --width and the camera's aspect ratio]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub height: Option<u32>,
+
+    /// Most bounces along a path; 0 shows emitters only, 1 direct light only.
+    #[arg(long, default_value_t = 16)]
+    pub max_depth: u32,
+
+    /// Random seed: the same seed gives a bit-identical image, whatever the thread count.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+
+    /// Worker threads. [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+
+    /// Camera to render, by name or by index in file order. [default: the first camera, or
+    /// one that frames the whole scene if the file has none]
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub camera: Option<String>,
+
+    /// No progress bar and no summary; warnings and errors are still printed.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Runs the command line and returns the process exit code.
+pub fn main() -> i32 {
+    let args = Args::parse();
+    match run(&args) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            2
+        }
+    }
+}
+
+/// Loads, renders and writes as `args` says.
+pub fn run(args: &Args) -> Result<()> {
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&args.scene));
+    check_writable(&output)?;
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = args.threads {
+        pool = pool.num_threads(n as usize);
+    }
+    let pool = pool.build().context("starting worker threads")?;
+
+    let load_start = Instant::now();
+    let loaded = load_scene(&args.scene)?;
+    for warning in &loaded.warnings {
+        eprintln!("warning: {warning}");
+    }
+    let scene = loaded.scene;
+    if scene.instanced_triangle_count() == 0 {
+        eprintln!(
+            "warning: {}: the scene has no triangles; the image will be empty",
+            args.scene.display()
+        );
+    } else if !scene.has_emitters() {
+        eprintln!(
+            "warning: {}: the scene has no emitters (no material with emission); the image will be black",
+            args.scene.display()
+        );
+    }
+
+    let camera = choose_camera(&scene, args.camera.as_deref(), args.width, args.height)?;
+    let (width, height) = image_size(args.width, args.height, camera.aspect_ratio());
+    if let (Some(w), Some(h), Some(aspect)) = (args.width, args.height, camera.aspect_ratio())
+        && ((w as f32 / h as f32) / aspect - 1.0).abs() > 0.01
+    {
+        eprintln!(
+            "note: {w}x{h} does not match the camera's aspect ratio {aspect:.3}; keeping its vertical field of view"
+        );
+    }
+    let settings = RenderSettings {
+        width,
+        height,
+        spp: args.spp,
+        max_depth: args.max_depth,
+        seed: args.seed,
+        strategy: Strategy::Mis,
+    };
+
+    let renderer = pool.install(|| Renderer::new(&scene));
+    if !args.quiet {
+        eprintln!(
+            "{}: {} triangles in {} instances, {} emissive; camera {}; prepared in {:.2} s",
+            args.scene.display(),
+            scene.instanced_triangle_count(),
+            scene.instances.len(),
+            renderer.lights().len(),
+            if camera.name.is_empty() {
+                &camera.source
+            } else {
+                &camera.name
+            },
+            load_start.elapsed().as_secs_f64()
+        );
+    }
+    let bar = progress_bar(height, args.quiet);
+    let (image, stats) = pool.install(|| renderer.render(&camera, &settings, &|| bar.inc(1)));
+    bar.finish_and_clear();
+    if stats.nonfinite > 0 {
+        eprintln!(
+            "warning: {} sample(s) were NaN or infinite and were dropped",
+            stats.nonfinite
+        );
+    }
+    write_image(&output, &image)?;
+    if !args.quiet {
+        let seconds = stats.elapsed.as_secs_f64().max(1e-9);
+        eprintln!(
+            "rendered {width}x{height} at {} spp in {seconds:.2} s: {:.2} M samples/s, {:.2} M rays/s; wrote {}",
+            settings.spp,
+            stats.samples as f64 / seconds / 1e6,
+            stats.rays as f64 / seconds / 1e6,
+            output.display()
+        );
+    }
+    Ok(())
+}
+
+/// `SCENE_STEM.exr` in the current folder.
+fn default_output(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from(format!("{stem}.exr"))
+}
+
+/// The camera asked for, the first one, or one that frames the scene.
+pub fn choose_camera(
+    scene: &Scene,
+    wanted: Option<&str>,
+    width: Option<u32>,
+    height: Option<u32>,
+) -> Result<Camera> {
+    let list = || {
+        if scene.cameras.is_empty() {
+            "the scene has no cameras".to_string()
+        } else {
+            let names: Vec<String> = scene
+                .cameras
+                .iter()
+                .enumerate()
+                .map(|(i, c)| format!("{i} '{}' ({})", c.name, c.source))
+                .collect();
+            format!("cameras: {}", names.join(", "))
+        }
+    };
+    match wanted {
+        Some(spec) => {
+            if let Ok(index) = spec.parse::<usize>() {
+                return scene
+                    .cameras
+                    .get(index)
+                    .cloned()
+                    .ok_or_else(|| anyhow!("no camera {index}; {}", list()));
+            }
+            let found = scene
+                .cameras
+                .iter()
+                .find(|c| c.name == spec || c.source.ends_with(&format!("'{spec}'")));
+            found
+                .cloned()
+                .ok_or_else(|| anyhow!("no camera named '{spec}'; {}", list()))
+        }
+        None => Ok(match scene.cameras.first() {
+            Some(c) => c.clone(),
+            None => {
+                let aspect = match (width, height) {
+                    (Some(w), Some(h)) => w as f32 / h as f32,
+                    _ => 1.0,
+                };
+                if scene.bounds().is_empty() {
+                    bail!("the scene has no geometry and no camera: nothing to render");
+                }
+                Camera::framing(&scene.bounds(), aspect)
+            }
+        }),
+    }
+}
+
+/// Image size from the options, filling a missing side from the camera's aspect ratio.
+pub fn image_size(width: Option<u32>, height: Option<u32>, aspect: Option<f32>) -> (u32, u32) {
+    let aspect = aspect.filter(|a| a.is_finite() && *a > 0.0).unwrap_or(1.0);
+    let from_aspect = |x: f32| (x.round() as u32).clamp(1, 65536);
+    match (width, height) {
+        (Some(w), Some(h)) => (w, h),
+        (Some(w), None) => (w, from_aspect(w as f32 / aspect)),
+        (None, Some(h)) => (from_aspect(h as f32 * aspect), h),
+        (None, None) => (from_aspect(DEFAULT_HEIGHT as f32 * aspect), DEFAULT_HEIGHT),
+    }
+}
+
+fn progress_bar(rows: u32, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(rows as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] [{bar:40}] {percent:>3}% rows, ETA {eta}",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn image_size_follows_the_camera_aspect() {
+        assert_eq!(image_size(None, None, Some(1.5)), (768, 512));
+        assert_eq!(image_size(Some(300), None, Some(1.5)), (300, 200));
+        assert_eq!(image_size(None, Some(100), None), (100, 100));
+        assert_eq!(image_size(Some(7), Some(9), Some(2.0)), (7, 9));
+    }
+}

@@ -1,0 +1,430 @@
+//! glTF 2.0 (`.gltf` with external or embedded buffers, and `.glb`) through the `gltf` crate.
+//!
+//! Material mapping (see the README's table): emission = `emissiveFactor` ×
+//! `KHR_materials_emissive_strength`; `KHR_materials_transmission` ≥ 0.5 → glass with
+//! `KHR_materials_ior` (default 1.5) tinted by the base colour; else `metallicFactor` ≥ 0.5 →
+//! mirror with reflectance = base colour; else Lambertian with the base colour.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use glam::{Affine3A, Mat4, Vec2, Vec3};
+use gltf::json::validation::Validate;
+use gltf::mesh::Mode;
+
+use super::{LoadError, Loaded};
+use crate::scene::{Camera, Material, MaterialKind, Mesh, Projection, SceneBuilder};
+
+/// Extensions whose meaning gridtrace implements.
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_materials_emissive_strength",
+    "KHR_materials_transmission",
+    "KHR_materials_ior",
+];
+
+/// Deepest node hierarchy accepted; deeper is treated as a cycle or an attack.
+const MAX_NODE_DEPTH: usize = 256;
+/// Most node visits in one scene (instancing through shared children multiplies visits).
+const MAX_NODE_VISITS: usize = 1_000_000;
+/// Grey for primitives without a material. glTF's default material is fully metallic,
+/// which would turn them into mirrors; viewers show grey plastic, and so do we.
+const DEFAULT_ALBEDO: f32 = 0.8;
+
+/// Loads a `.gltf` or `.glb` file.
+pub fn load(path: &Path) -> Result<Loaded, LoadError> {
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let gltf_error = |message: String| LoadError::Gltf {
+        path: path.to_path_buf(),
+        message,
+    };
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| gltf_error(e.to_string()))?;
+    let mut warnings = Vec::new();
+    check_extensions(path, &document, &mut warnings)?;
+    validate(&document).map_err(gltf_error)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let buffers = gltf::import_buffers(&document, Some(base), blob)
+        .map_err(|e| gltf_error(format!("loading buffers: {e}")))?;
+    let mut loader = GltfLoader {
+        path: path.to_path_buf(),
+        buffers,
+        builder: SceneBuilder::new(),
+        meshes: HashMap::new(),
+        default_material: None,
+        warnings,
+    };
+    for material in document.materials() {
+        let m = loader.convert_material(&material);
+        loader.builder.add_material(m);
+    }
+    loader.load_scene(&document)?;
+    Ok(Loaded {
+        scene: loader.builder.build(),
+        warnings: loader.warnings,
+    })
+}
+
+fn check_extensions(
+    path: &Path,
+    document: &gltf::Document,
+    warnings: &mut Vec<String>,
+) -> Result<(), LoadError> {
+    let unsupported = |name: &&str| !SUPPORTED_EXTENSIONS.contains(name);
+    let required: Vec<String> = document
+        .extensions_required()
+        .filter(unsupported)
+        .map(String::from)
+        .collect();
+    if !required.is_empty() {
+        return Err(LoadError::UnsupportedRequiredExtension {
+            path: path.to_path_buf(),
+            names: required,
+        });
+    }
+    let ignored: Vec<&str> = document.extensions_used().filter(unsupported).collect();
+    if !ignored.is_empty() {
+        warnings.push(format!(
+            "{}: ignoring unsupported glTF extension(s): {}",
+            path.display(),
+            ignored.join(", ")
+        ));
+    }
+    Ok(())
+}
+
+/// The glTF schema checks (index ranges, required fields), reported with their JSON paths.
+fn validate(document: &gltf::Document) -> Result<(), String> {
+    let root = document.as_json();
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        errors.push(format!("{}: {error}", path()))
+    });
+    match errors.len() {
+        0 => Ok(()),
+        1 => Err(errors.remove(0)),
+        n => Err(format!("{} (and {} more problems)", errors[0], n - 1)),
+    }
+}
+
+struct GltfLoader {
+    path: PathBuf,
+    buffers: Vec<gltf::buffer::Data>,
+    builder: SceneBuilder,
+    /// Our mesh indices for each glTF mesh, one per triangle primitive, made on first use.
+    meshes: HashMap<usize, Vec<usize>>,
+    default_material: Option<usize>,
+    warnings: Vec<String>,
+}
+
+impl GltfLoader {
+    fn invalid(&self, what: String) -> LoadError {
+        LoadError::Invalid {
+            path: self.path.clone(),
+            what,
+        }
+    }
+
+    fn warn(&mut self, what: String) {
+        self.warnings
+            .push(format!("{}: {what}", self.path.display()));
+    }
+
+    fn convert_material(&mut self, material: &gltf::Material) -> Material {
+        let name = material.name().map_or_else(
+            || format!("material {}", material.index().unwrap_or(0)),
+            String::from,
+        );
+        let pbr = material.pbr_metallic_roughness();
+        let [r, g, b, _] = pbr.base_color_factor();
+        let base = Vec3::new(r, g, b);
+        let emission =
+            Vec3::from(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0);
+        let transmission = material
+            .transmission()
+            .map_or(0.0, |t| t.transmission_factor());
+        let kind = if transmission >= 0.5 {
+            MaterialKind::Glass {
+                ior: material.ior().unwrap_or(1.5),
+                tint: base,
+            }
+        } else if pbr.metallic_factor() >= 0.5 {
+            MaterialKind::Mirror { reflectance: base }
+        } else {
+            MaterialKind::Diffuse { albedo: base }
+        };
+        let textured = pbr.base_color_texture().is_some()
+            || pbr.metallic_roughness_texture().is_some()
+            || material.emissive_texture().is_some()
+            || material.normal_texture().is_some();
+        if textured {
+            self.warn(format!(
+                "material '{name}': textures are not supported yet; using its constant factors"
+            ));
+        }
+        Material {
+            name,
+            kind,
+            emission,
+            double_sided: material.double_sided(),
+        }
+    }
+
+    fn material_for(&mut self, primitive: &gltf::Primitive) -> usize {
+        if let Some(i) = primitive.material().index() {
+            return i;
+        }
+        *self.default_material.get_or_insert_with(|| {
+            self.builder
+                .add_material(Material::diffuse("default", Vec3::splat(DEFAULT_ALBEDO)))
+        })
+    }
+
+    fn load_scene(&mut self, document: &gltf::Document) -> Result<(), LoadError> {
+        let scene = match document
+            .default_scene()
+            .or_else(|| document.scenes().next())
+        {
+            Some(s) => s,
+            None => return Err(self.invalid("the file has no scene".into())),
+        };
+        let mut stack: Vec<(gltf::Node, Mat4, usize)> =
+            scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+        stack.reverse();
+        let mut visits = 0;
+        while let Some((node, parent, depth)) = stack.pop() {
+            visits += 1;
+            if depth > MAX_NODE_DEPTH || visits > MAX_NODE_VISITS {
+                return Err(self.invalid(format!(
+                    "node hierarchy too deep or too large at node {} (cyclic?)",
+                    node.index()
+                )));
+            }
+            let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+            if !world.is_finite() {
+                return Err(
+                    self.invalid(format!("node {} has a non-finite transform", node.index()))
+                );
+            }
+            let source = match node.name() {
+                Some(name) => format!("node {} '{name}'", node.index()),
+                None => format!("node {}", node.index()),
+            };
+            if let Some(mesh) = node.mesh() {
+                for our_mesh in self.meshes_of(&mesh)? {
+                    self.builder
+                        .add_instance(our_mesh, Affine3A::from_mat4(world), source.clone());
+                }
+            }
+            if let Some(camera) = node.camera() {
+                self.add_camera(&camera, world, &source);
+            }
+            let children: Vec<_> = node.children().map(|c| (c, world, depth + 1)).collect();
+            stack.extend(children.into_iter().rev());
+        }
+        Ok(())
+    }
+
+    fn add_camera(&mut self, camera: &gltf::Camera, world: Mat4, source: &str) {
+        // Scale in a camera's node would distort distances; keep rotation and translation.
+        let (_, rotation, translation) = world.to_scale_rotation_translation();
+        let (projection, znear) = match camera.projection() {
+            gltf::camera::Projection::Perspective(p) => (
+                Projection::Perspective {
+                    yfov: p.yfov(),
+                    aspect_ratio: p.aspect_ratio(),
+                },
+                p.znear(),
+            ),
+            gltf::camera::Projection::Orthographic(o) => (
+                Projection::Orthographic {
+                    xmag: o.xmag().abs(),
+                    ymag: o.ymag().abs(),
+                },
+                o.znear(),
+            ),
+        };
+        self.builder.add_camera(Camera {
+            name: camera.name().unwrap_or_default().to_string(),
+            world_from_camera: Affine3A::from_rotation_translation(
+                rotation.normalize(),
+                translation,
+            ),
+            projection,
+            znear,
+            source: source.to_string(),
+        });
+    }
+
+    /// Our meshes for a glTF mesh, converting it the first time it is used.
+    fn meshes_of(&mut self, mesh: &gltf::Mesh) -> Result<Vec<usize>, LoadError> {
+        if let Some(ours) = self.meshes.get(&mesh.index()) {
+            return Ok(ours.clone());
+        }
+        let mut ours = Vec::new();
+        for primitive in mesh.primitives() {
+            if let Some(m) = self.convert_primitive(mesh, &primitive)? {
+                ours.push(self.builder.add_full_mesh(m));
+            }
+        }
+        self.meshes.insert(mesh.index(), ours.clone());
+        Ok(ours)
+    }
+
+    fn convert_primitive(
+        &mut self,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+    ) -> Result<Option<Mesh>, LoadError> {
+        let name = format!(
+            "mesh {} '{}' primitive {}",
+            mesh.index(),
+            mesh.name().unwrap_or(""),
+            primitive.index()
+        );
+        if matches!(
+            primitive.mode(),
+            Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip
+        ) {
+            self.warn(format!(
+                "{name}: skipping {:?} primitive (only triangles are rendered)",
+                primitive.mode()
+            ));
+            return Ok(None);
+        }
+        for (_, accessor) in primitive.attributes() {
+            self.check_accessor(&accessor, &name)?;
+        }
+        if let Some(accessor) = primitive.indices() {
+            self.check_accessor(&accessor, &name)?;
+        }
+        let buffers = &self.buffers;
+        let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let Some(positions) = reader.read_positions() else {
+            return Err(self.invalid(format!("{name}: no POSITION attribute")));
+        };
+        let positions: Vec<Vec3> = positions.map(Vec3::from).collect();
+        let corners: Vec<u32> = match reader.read_indices() {
+            Some(indices) => indices.into_u32().collect(),
+            None => (0..positions.len() as u32).collect(),
+        };
+        if let Some(&bad) = corners.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(self.invalid(format!(
+                "{name}: index {bad} is past the {} vertices",
+                positions.len()
+            )));
+        }
+        let indices = triangles(primitive.mode(), &corners);
+        let leftover = if primitive.mode() == Mode::Triangles {
+            corners.len() % 3
+        } else {
+            0
+        };
+        let normals = match reader.read_normals() {
+            Some(n) => n
+                .map(|n| Vec3::from(n).try_normalize().unwrap_or(Vec3::ZERO))
+                .collect::<Vec<_>>(),
+            None => Vec::new(),
+        };
+        let normals =
+            if normals.len() == positions.len() && normals.iter().all(|n| *n != Vec3::ZERO) {
+                normals
+            } else {
+                Mesh::compute_vertex_normals(&positions, &indices)
+            };
+        let uvs: Vec<Vec2> = match reader.read_tex_coords(0) {
+            Some(t) => t.into_f32().map(Vec2::from).collect(),
+            None => Vec::new(),
+        };
+        if leftover != 0 {
+            self.warn(format!(
+                "{name}: {leftover} index(es) left over after the last whole triangle"
+            ));
+        }
+        let material = self.material_for(primitive);
+        Ok(Some(Mesh {
+            name,
+            positions,
+            normals,
+            uvs,
+            indices,
+            material,
+        }))
+    }
+
+    /// Rejects accessors whose data would run past their buffer view or buffer.
+    fn check_accessor(&self, accessor: &gltf::Accessor, name: &str) -> Result<(), LoadError> {
+        if accessor.sparse().is_some() {
+            return Err(self.invalid(format!(
+                "{name}: sparse accessor {} is not supported",
+                accessor.index()
+            )));
+        }
+        let Some(view) = accessor.view() else {
+            return Ok(());
+        };
+        let element = accessor.size();
+        let stride = view.stride().unwrap_or(element);
+        let needed = match accessor.count() {
+            0 => 0,
+            n => accessor.offset() + stride * (n - 1) + element,
+        };
+        let buffer_len = self
+            .buffers
+            .get(view.buffer().index())
+            .map_or(0, |b| b.0.len());
+        if needed > view.length() || view.offset() + view.length() > buffer_len {
+            return Err(self.invalid(format!(
+                "{name}: accessor {} needs {needed} bytes but buffer view {} holds {} (buffer {} has {buffer_len})",
+                accessor.index(),
+                view.index(),
+                view.length(),
+                view.buffer().index()
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Triangles from a list, strip or fan of corner indices (glTF 2.0 §3.7.2.1).
+fn triangles(mode: Mode, corners: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::TriangleStrip => (0..corners.len().saturating_sub(2))
+            .map(|i| {
+                if i % 2 == 0 {
+                    [corners[i], corners[i + 1], corners[i + 2]]
+                } else {
+                    [corners[i], corners[i + 2], corners[i + 1]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (1..corners.len().saturating_sub(1))
+            .map(|i| [corners[i], corners[i + 1], corners[0]])
+            .collect(),
+        _ => corners
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_keep_winding() {
+        assert_eq!(
+            triangles(Mode::TriangleStrip, &[0, 1, 2, 3]),
+            vec![[0, 1, 2], [1, 3, 2]]
+        );
+        assert_eq!(
+            triangles(Mode::TriangleFan, &[0, 1, 2, 3]),
+            vec![[1, 2, 0], [2, 3, 0]]
+        );
+        assert_eq!(triangles(Mode::Triangles, &[0, 1, 2, 3]), vec![[0, 1, 2]]);
+        assert!(triangles(Mode::TriangleStrip, &[0, 1]).is_empty());
+    }
+}

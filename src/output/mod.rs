@@ -1,0 +1,137 @@
+//! Writing images: OpenEXR (linear float) and PNG (sRGB 8-bit), always atomically.
+
+mod exr;
+mod png;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::render::Image;
+
+/// An image file format gridtrace writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// OpenEXR, 32-bit float linear RGBA.
+    Exr,
+    /// PNG, 8-bit sRGB RGB.
+    Png,
+}
+
+/// Why an image could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The extension names no format we write.
+    #[error("{path}: unknown output format (use .exr or .png)")]
+    UnknownFormat {
+        /// The requested output path.
+        path: PathBuf,
+    },
+    /// Encoding or file-system failure.
+    #[error("{path}: {message}")]
+    Write {
+        /// The output path.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl Format {
+    /// The format named by the file's extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Format, OutputError> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("exr") => Ok(Format::Exr),
+            Some("png") => Ok(Format::Png),
+            _ => Err(OutputError::UnknownFormat {
+                path: path.to_path_buf(),
+            }),
+        }
+    }
+}
+
+/// Encodes `image` in the format of `path`'s extension and writes it atomically: the bytes
+/// go to a temporary file in the same folder, which is renamed over `path` only when
+/// complete, so an earlier image at `path` survives any failure.
+pub fn write_image(path: &Path, image: &Image) -> Result<(), OutputError> {
+    let bytes = match Format::from_path(path)? {
+        Format::Exr => exr::encode(image),
+        Format::Png => png::encode(image),
+    }
+    .map_err(|message| OutputError::Write {
+        path: path.to_path_buf(),
+        message,
+    })?;
+    write_atomically(path, &bytes)
+}
+
+/// Checks before a long render that `path` has a known format and that its folder accepts
+/// new files, so the render is not lost at the end.
+pub fn check_writable(path: &Path) -> Result<(), OutputError> {
+    Format::from_path(path)?;
+    tempfile::NamedTempFile::new_in(parent_dir(path))
+        .map(drop)
+        .map_err(|e| OutputError::Write {
+            path: path.to_path_buf(),
+            message: format!("cannot write here: {e}"),
+        })
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    let fail = |e: std::io::Error| OutputError::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let mut file = tempfile::NamedTempFile::new_in(parent_dir(path)).map_err(fail)?;
+    file.write_all(bytes).map_err(fail)?;
+    file.as_file().sync_all().map_err(fail)?;
+    file.persist(path).map_err(|e| fail(e.error))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn formats_follow_the_extension() {
+        assert_eq!(
+            Format::from_path(Path::new("a/b.EXR")).unwrap(),
+            Format::Exr
+        );
+        assert_eq!(Format::from_path(Path::new("b.png")).unwrap(), Format::Png);
+        assert!(Format::from_path(Path::new("b.jpg")).is_err());
+        assert!(Format::from_path(Path::new("b")).is_err());
+    }
+
+    #[test]
+    fn a_failed_write_keeps_the_previous_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.png");
+        let mut image = Image::new(2, 1);
+        image.pixels[0] = Vec3::ONE;
+        write_image(&path, &image).unwrap();
+        let before = std::fs::read(&path).unwrap();
+        // Writing to a path whose "folder" is a file fails; the earlier image is untouched.
+        let bad = path.join("x.png");
+        assert!(write_image(&bad, &image).is_err());
+        assert_eq!(std::fs::read(&path).unwrap(), before);
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary files left"
+        );
+    }
+}

@@ -1,0 +1,90 @@
+//! Turning a scene camera and an image size into primary rays.
+
+use glam::{Affine3A, Vec2, Vec3};
+
+use crate::accel::Ray;
+use crate::scene::{Camera, Projection};
+
+/// Generates the ray through a point of the image plane.
+#[derive(Clone, Debug)]
+pub struct RayGenerator {
+    world_from_camera: Affine3A,
+    projection: Projection,
+    /// Half-extent of the image plane at distance 1 (perspective) or in scene units
+    /// (orthographic), horizontally and vertically.
+    half_extent: Vec2,
+    znear: f32,
+    width: u32,
+    height: u32,
+}
+
+impl RayGenerator {
+    /// Rays for a `width`×`height` image. The vertical field of view (or `ymag`) is kept and
+    /// the horizontal one follows the image's aspect ratio.
+    pub fn new(camera: &Camera, width: u32, height: u32) -> RayGenerator {
+        let aspect = width as f32 / height as f32;
+        let half_extent = match camera.projection {
+            Projection::Perspective { yfov, .. } => {
+                let h = (0.5 * yfov).tan();
+                Vec2::new(h * aspect, h)
+            }
+            Projection::Orthographic { ymag, .. } => Vec2::new(ymag * aspect, ymag),
+        };
+        RayGenerator {
+            world_from_camera: camera.world_from_camera,
+            projection: camera.projection,
+            half_extent,
+            znear: camera.znear.max(0.0),
+            width,
+            height,
+        }
+    }
+
+    /// The ray through image position (`x`, `y`) in pixels, (0, 0) at the top-left corner.
+    ///
+    /// The direction is not normalised: its camera-space z is −1, so `t_min = znear` clips
+    /// exactly at the near plane.
+    pub fn generate(&self, x: f32, y: f32) -> Ray {
+        let ndc = Vec2::new(
+            2.0 * x / self.width as f32 - 1.0,
+            1.0 - 2.0 * y / self.height as f32,
+        );
+        let plane = ndc * self.half_extent;
+        let (origin, direction) = match self.projection {
+            Projection::Perspective { .. } => (Vec3::ZERO, Vec3::new(plane.x, plane.y, -1.0)),
+            Projection::Orthographic { .. } => (Vec3::new(plane.x, plane.y, 0.0), Vec3::NEG_Z),
+        };
+        Ray {
+            origin: self.world_from_camera.transform_point3(origin),
+            direction: self.world_from_camera.transform_vector3(direction),
+            t_min: self.znear,
+            t_max: f32::INFINITY,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn corners_span_the_vertical_field_of_view() {
+        let cam = Camera {
+            name: String::new(),
+            world_from_camera: Affine3A::from_translation(Vec3::new(0.0, 0.0, 5.0)),
+            projection: Projection::Perspective {
+                yfov: 90f32.to_radians(),
+                aspect_ratio: None,
+            },
+            znear: 0.1,
+            source: String::new(),
+        };
+        let g = RayGenerator::new(&cam, 200, 100);
+        let top = g.generate(100.0, 0.0);
+        assert!((top.direction - Vec3::new(0.0, 1.0, -1.0)).length() < 1e-6);
+        let right = g.generate(200.0, 50.0);
+        assert!((right.direction - Vec3::new(2.0, 0.0, -1.0)).length() < 1e-6);
+        assert_eq!(top.origin, Vec3::new(0.0, 0.0, 5.0));
+        assert_eq!(top.t_min, 0.1);
+    }
+}

@@ -1,0 +1,203 @@
+//! Unidirectional path tracing with next-event estimation on area lights and multiple
+//! importance sampling (Veach 1997, ch. 9; pbrt-v4 §13.4).
+//!
+//! At each vertex the shading normal is turned to the side of the surface the path arrives
+//! from; a scattered direction that the shading normal allows but the geometric normal
+//! does not (a light leak) ends the path.
+
+use glam::Vec3;
+
+use super::Renderer;
+use super::bsdf::Bsdf;
+use super::sampling::{Rng, power_heuristic};
+use super::surface::surface_at;
+use crate::accel::Ray;
+
+/// How direct light is estimated. Only [`Strategy::Mis`] is meant for images; the other two
+/// exist to check that all three converge to the same answer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Strategy {
+    /// Light sampling and BSDF sampling combined with the power heuristic.
+    #[default]
+    Mis,
+    /// Emission is found only by sampling lights (and after delta bounces).
+    LightOnly,
+    /// Emission is found only by hitting it with BSDF-sampled rays.
+    BsdfOnly,
+}
+
+/// Path depth at which Russian roulette starts.
+const ROULETTE_DEPTH: u32 = 3;
+
+/// How the path reached its current vertex.
+#[derive(Clone, Copy)]
+enum Arrival {
+    /// From the camera or through a delta lobe: emission is counted in full.
+    Specular,
+    /// From a non-delta BSDF sample with this solid-angle pdf.
+    Scattered { pdf: f32 },
+}
+
+/// The radiance estimate of one path and what it cost.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PathResult {
+    /// Radiance along the camera ray.
+    pub radiance: Vec3,
+    /// True when the camera ray hit geometry (for the alpha channel).
+    pub hit: bool,
+    /// Rays traced: closest-hit and shadow.
+    pub rays: u64,
+}
+
+impl Renderer<'_> {
+    /// Estimates the radiance arriving along `ray` (pointing into the scene).
+    pub fn trace_path(
+        &self,
+        mut ray: Ray,
+        rng: &mut Rng,
+        max_depth: u32,
+        strategy: Strategy,
+    ) -> PathResult {
+        let mut result = PathResult::default();
+        let mut beta = Vec3::ONE;
+        let mut eta_scale = 1.0f32;
+        let mut arrival = Arrival::Specular;
+        for depth in 0.. {
+            result.rays += 1;
+            let Some(hit) = self.accel.intersect(&ray) else {
+                break;
+            };
+            result.hit |= depth == 0;
+            let s = surface_at(self.scene, &self.frames, &hit, ray.at(hit.t));
+            let wo = -ray.direction.normalize();
+            let cos_o = s.geometric_normal.dot(wo);
+            let front = cos_o > 0.0;
+            let material = &self.scene.materials[s.material];
+
+            // Emission reached by the previous bounce.
+            if material.is_emissive() && (front || material.double_sided) {
+                let weight = match (arrival, strategy) {
+                    (Arrival::Specular, _) | (_, Strategy::BsdfOnly) => 1.0,
+                    (Arrival::Scattered { .. }, Strategy::LightOnly) => 0.0,
+                    (Arrival::Scattered { pdf }, Strategy::Mis) => {
+                        let distance = hit.t * ray.direction.length();
+                        power_heuristic(
+                            pdf,
+                            self.lights.pdf(hit.instance, hit.triangle, distance, cos_o),
+                        )
+                    }
+                };
+                result.radiance += weight * beta * material.emission;
+            }
+            if depth == max_depth || (!front && !material.double_sided) {
+                break;
+            }
+
+            let ng = if front {
+                s.geometric_normal
+            } else {
+                -s.geometric_normal
+            };
+            let ns = if s.shading_normal.dot(ng) < 0.0 {
+                -s.shading_normal
+            } else {
+                s.shading_normal
+            };
+            let bsdf = self.bsdfs[s.material];
+
+            // Sample a light for the next-event estimate.
+            if !bsdf.is_delta() && strategy != Strategy::BsdfOnly {
+                result.rays += 1;
+                result.radiance +=
+                    beta * self.direct_light(&bsdf, s.point, ng, ns, wo, rng, strategy);
+            }
+
+            // Sample the BSDF to extend the path.
+            let Some(sample) = bsdf.sample(ns, wo, front, rng.uniform2(), rng.uniform()) else {
+                break;
+            };
+            let side = sample.wi.dot(ng);
+            if (sample.is_transmission && side >= 0.0) || (!sample.is_transmission && side <= 0.0) {
+                break;
+            }
+            beta *= sample.weight;
+            eta_scale *= sample.eta_scale;
+            arrival = if sample.is_delta {
+                Arrival::Specular
+            } else {
+                Arrival::Scattered { pdf: sample.pdf }
+            };
+            ray = Ray::new(self.offset(s.point, ng, side), sample.wi);
+
+            // Possibly terminate the path with Russian roulette. The throughput is judged
+            // without the radiance scaling of refractions, which cancels on leaving glass.
+            if depth + 1 >= ROULETTE_DEPTH {
+                let rr = (beta / eta_scale).max_element();
+                if rr < 1.0 {
+                    let q = (1.0 - rr).max(0.05).min(0.95);
+                    if rng.uniform() < q {
+                        break;
+                    }
+                    beta /= 1.0 - q;
+                }
+            }
+            if !beta.is_finite() || beta == Vec3::ZERO {
+                break;
+            }
+        }
+        result
+    }
+
+    /// One light-sampling estimate of reflected direct light, MIS-weighted when asked.
+    #[allow(clippy::too_many_arguments)]
+    fn direct_light(
+        &self,
+        bsdf: &Bsdf,
+        p: Vec3,
+        ng: Vec3,
+        ns: Vec3,
+        wo: Vec3,
+        rng: &mut Rng,
+        strategy: Strategy,
+    ) -> Vec3 {
+        let u_light = rng.uniform();
+        let u = rng.uniform2();
+        let Some(ls) = self.lights.sample(p, u_light, u) else {
+            return Vec3::ZERO;
+        };
+        if ls.radiance == Vec3::ZERO || ng.dot(ls.wi) <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let f = bsdf.eval(ns, wo, ls.wi) * ns.dot(ls.wi).abs();
+        if f == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        let origin = self.offset(p, ng, 1.0);
+        let towards = if ls.normal.dot(ls.wi) < 0.0 {
+            ls.normal
+        } else {
+            -ls.normal
+        };
+        let target = ls.point + towards * self.ray_epsilon;
+        let shadow = Ray {
+            origin,
+            direction: target - origin,
+            t_min: 0.0,
+            t_max: 1.0,
+        };
+        if self.accel.occluded(&shadow) {
+            return Vec3::ZERO;
+        }
+        let weight = match strategy {
+            Strategy::Mis => power_heuristic(ls.pdf, bsdf.pdf(ns, wo, ls.wi)),
+            _ => 1.0,
+        };
+        f * ls.radiance * (weight / ls.pdf)
+    }
+
+    /// A ray origin moved off the surface along the geometric normal, to the side
+    /// (`side` > 0: the side `ng` points to) the new ray leaves by.
+    fn offset(&self, p: Vec3, ng: Vec3, side: f32) -> Vec3 {
+        p + ng * self.ray_epsilon.copysign(side)
+    }
+}

@@ -1,0 +1,166 @@
+//! Area lights: every triangle of an emissive material, in world space, chosen for
+//! next-event estimation in proportion to its emitted power.
+
+use glam::{Vec2, Vec3};
+
+use super::sampling::{Distribution1d, uniform_triangle};
+use crate::scene::Scene;
+
+/// One emitting triangle in world space.
+#[derive(Clone, Copy, Debug)]
+struct EmissiveTriangle {
+    v0: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    /// Unit geometric normal, on the side the winding calls front.
+    normal: Vec3,
+    area: f32,
+    radiance: Vec3,
+    double_sided: bool,
+}
+
+/// A point drawn on a light, as seen from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// The point on the light.
+    pub point: Vec3,
+    /// The light's unit normal there (front side).
+    pub normal: Vec3,
+    /// Unit direction from the shading point to the light point.
+    pub wi: Vec3,
+    /// Distance from the shading point to the light point.
+    pub distance: f32,
+    /// Radiance leaving the light towards the shading point.
+    pub radiance: Vec3,
+    /// Solid-angle density of `wi` at the shading point.
+    pub pdf: f32,
+}
+
+/// All emissive triangles of a scene and the distribution used to pick them.
+pub struct LightSet {
+    triangles: Vec<EmissiveTriangle>,
+    distribution: Distribution1d,
+    /// For each instance, the index of its mesh's first triangle in `triangles`, if emissive.
+    first_of_instance: Vec<Option<u32>>,
+}
+
+impl LightSet {
+    /// Collects the emissive triangles of every instance.
+    pub fn build(scene: &Scene) -> LightSet {
+        let mut triangles = Vec::new();
+        let mut first_of_instance = Vec::with_capacity(scene.instances.len());
+        for inst in &scene.instances {
+            let mesh = &scene.meshes[inst.mesh];
+            let material = &scene.materials[mesh.material];
+            if !material.is_emissive() {
+                first_of_instance.push(None);
+                continue;
+            }
+            first_of_instance.push(Some(triangles.len() as u32));
+            let m = inst.world_from_object;
+            for &[a, b, c] in &mesh.indices {
+                let [p0, p1, p2] =
+                    [a, b, c].map(|i| m.transform_point3(mesh.positions[i as usize]));
+                let (e1, e2) = (p1 - p0, p2 - p0);
+                let cross = e1.cross(e2);
+                let area = 0.5 * cross.length();
+                let usable = area.is_finite() && area > 0.0;
+                // Mirroring transforms flip the winding; the normal follows the object-space
+                // front face, which is what the renderer's hit normal uses too.
+                let sign = if m.matrix3.determinant() < 0.0 {
+                    -1.0
+                } else {
+                    1.0
+                };
+                triangles.push(EmissiveTriangle {
+                    v0: p0,
+                    e1,
+                    e2,
+                    normal: if usable {
+                        sign * cross / (2.0 * area)
+                    } else {
+                        Vec3::Z
+                    },
+                    area: if usable { area } else { 0.0 },
+                    radiance: material.emission,
+                    double_sided: material.double_sided,
+                });
+            }
+        }
+        let weights = triangles
+            .iter()
+            .map(|t| {
+                let sides = if t.double_sided { 2.0 } else { 1.0 };
+                t.area * sides * std::f32::consts::PI * t.radiance.element_sum() / 3.0
+            })
+            .collect();
+        LightSet {
+            triangles,
+            distribution: Distribution1d::new(weights),
+            first_of_instance,
+        }
+    }
+
+    /// True when nothing emits.
+    pub fn is_empty(&self) -> bool {
+        self.distribution.total() <= 0.0
+    }
+
+    /// Number of emissive triangles.
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Total emitted power (W), summed over channels' mean.
+    pub fn total_power(&self) -> f64 {
+        self.distribution.total()
+    }
+
+    /// Draws a point on a light for shading point `p`: a triangle by power, then a uniform
+    /// point on it; the area density is turned into solid angle by distance²/|cos θ_light|.
+    pub fn sample(&self, p: Vec3, u_light: f32, u: Vec2) -> Option<LightSample> {
+        let (index, pmf) = self.distribution.sample(u_light)?;
+        let tri = &self.triangles[index];
+        let b = uniform_triangle(u);
+        let point = tri.v0 + b.x * tri.e1 + b.y * tri.e2;
+        let to_light = point - p;
+        let distance_sq = to_light.length_squared();
+        let distance = distance_sq.sqrt();
+        if distance == 0.0 {
+            return None;
+        }
+        let wi = to_light / distance;
+        let cos_light = tri.normal.dot(-wi);
+        if cos_light == 0.0 {
+            return None;
+        }
+        let pdf = pmf / tri.area * distance_sq / cos_light.abs();
+        let radiance = if tri.double_sided || cos_light > 0.0 {
+            tri.radiance
+        } else {
+            Vec3::ZERO
+        };
+        Some(LightSample {
+            point,
+            normal: tri.normal,
+            wi,
+            distance,
+            radiance,
+            pdf,
+        })
+    }
+
+    /// The solid-angle density with which [`LightSet::sample`] would pick the point of
+    /// triangle `triangle` of instance `instance` at `distance` and light cosine `cos_light`.
+    pub fn pdf(&self, instance: u32, triangle: u32, distance: f32, cos_light: f32) -> f32 {
+        let Some(first) = self.first_of_instance[instance as usize] else {
+            return 0.0;
+        };
+        let index = (first + triangle) as usize;
+        let tri = &self.triangles[index];
+        if tri.area == 0.0 || cos_light == 0.0 {
+            return 0.0;
+        }
+        self.distribution.pmf(index) / tri.area * distance * distance / cos_light.abs()
+    }
+}

@@ -1,0 +1,47 @@
+//! Triangle meshes in object space.
+
+use glam::{Vec2, Vec3};
+
+use super::Aabb;
+
+/// An indexed triangle mesh with one material.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Name for messages (for glTF: mesh name and primitive index).
+    pub name: String,
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals, unit length; same length as `positions`.
+    pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates; empty or same length as `positions`.
+    pub uvs: Vec<Vec2>,
+    /// Triangles as vertex indices, counter-clockwise seen from the front.
+    pub indices: Vec<[u32; 3]>,
+    /// Index into [`super::Scene::materials`].
+    pub material: usize,
+}
+
+impl Mesh {
+    /// Bounds of the vertices used by triangles.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.positions.iter().copied())
+    }
+
+    /// Area-weighted vertex normals, for meshes that come without normals.
+    ///
+    /// Vertices used by no triangle (or only by degenerate ones) get +Z.
+    pub fn compute_vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
+        let mut sums = vec![Vec3::ZERO; positions.len()];
+        for tri in indices {
+            let [a, b, c] = tri.map(|i| positions[i as usize]);
+            // The cross product's length is twice the area: an area weight for free.
+            let n = (b - a).cross(c - a);
+            for &i in tri {
+                sums[i as usize] += n;
+            }
+        }
+        sums.into_iter()
+            .map(|n| n.try_normalize().unwrap_or(Vec3::Z))
+            .collect()
+    }
+}

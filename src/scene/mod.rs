@@ -1,0 +1,142 @@
+//! The internal scene: plain data that every loader produces and the renderer consumes.
+//!
+//! Nothing here knows about file formats or about acceleration structures. Each item keeps
+//! a `source` string (glTF node index and name, USD prim path, …) so messages can say where
+//! a problem came from.
+
+mod builder;
+mod camera;
+mod material;
+mod mesh;
+
+pub use builder::SceneBuilder;
+pub use camera::{Camera, Projection};
+pub use material::{Material, MaterialKind};
+pub use mesh::Mesh;
+
+use glam::{Affine3A, Vec3};
+
+/// One placement of a mesh in the world. Many instances may share one mesh.
+#[derive(Clone, Debug)]
+pub struct Instance {
+    /// Index into [`Scene::meshes`].
+    pub mesh: usize,
+    /// Object-to-world transform.
+    pub world_from_object: Affine3A,
+    /// Where this instance came from, for messages.
+    pub source: String,
+}
+
+/// An axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: Vec3,
+    /// Largest corner.
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box: the identity for [`Aabb::union`].
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::INFINITY,
+        max: Vec3::NEG_INFINITY,
+    };
+
+    /// The smallest box holding all `points`.
+    pub fn from_points(points: impl IntoIterator<Item = Vec3>) -> Aabb {
+        points.into_iter().fold(Aabb::EMPTY, |b, p| b.grow(p))
+    }
+
+    /// This box grown to hold `p`.
+    pub fn grow(self, p: Vec3) -> Aabb {
+        Aabb {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    /// The smallest box holding both.
+    pub fn union(self, other: Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    /// True when the box holds no point.
+    pub fn is_empty(&self) -> bool {
+        self.min.cmpgt(self.max).any()
+    }
+
+    /// Side lengths.
+    pub fn extent(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    /// Centre point.
+    pub fn center(&self) -> Vec3 {
+        0.5 * (self.min + self.max)
+    }
+
+    /// The eight corners.
+    pub fn corners(&self) -> [Vec3; 8] {
+        std::array::from_fn(|i| {
+            Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            )
+        })
+    }
+
+    /// The bounding box of this box after an affine transform.
+    pub fn transformed(&self, m: &Affine3A) -> Aabb {
+        if self.is_empty() {
+            return *self;
+        }
+        Aabb::from_points(self.corners().map(|c| m.transform_point3(c)))
+    }
+}
+
+/// A complete scene ready to render.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// Triangle meshes in object space.
+    pub meshes: Vec<Mesh>,
+    /// Placements of meshes in the world.
+    pub instances: Vec<Instance>,
+    /// Materials, indexed by [`Mesh::material`].
+    pub materials: Vec<Material>,
+    /// Cameras found in the file, in file order.
+    pub cameras: Vec<Camera>,
+}
+
+impl Scene {
+    /// World-space bounds of every instance.
+    pub fn bounds(&self) -> Aabb {
+        self.instances.iter().fold(Aabb::EMPTY, |b, inst| {
+            b.union(
+                self.meshes[inst.mesh]
+                    .bounds()
+                    .transformed(&inst.world_from_object),
+            )
+        })
+    }
+
+    /// True when some instanced mesh has an emissive material.
+    pub fn has_emitters(&self) -> bool {
+        self.instances.iter().any(|inst| {
+            let mesh = &self.meshes[inst.mesh];
+            self.materials[mesh.material].is_emissive() && !mesh.indices.is_empty()
+        })
+    }
+
+    /// Number of triangles after instancing.
+    pub fn instanced_triangle_count(&self) -> usize {
+        self.instances
+            .iter()
+            .map(|i| self.meshes[i.mesh].indices.len())
+            .sum()
+    }
+}
