@@ -6,7 +6,7 @@ mod instances;
 mod ray;
 mod triangle;
 
-pub use grid::{Grid, GridStats};
+pub use grid::{Grid, GridHit, GridStats};
 pub use instances::{SceneAccel, SceneHit};
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};

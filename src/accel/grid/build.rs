@@ -91,16 +91,24 @@ impl Grid {
 
     /// Calls `f` with the index of every cell the triangle overlaps.
     fn for_each_overlapped_cell(&self, t: u32, mut f: impl FnMut(usize)) {
+        // Pad cells a little so rounding never drops a cell the triangle touches: a triangle
+        // lying on a cell face belongs to the cells on both sides.
+        let magnitude = self
+            .bounds
+            .min
+            .abs()
+            .max(self.bounds.max.abs())
+            .max_element();
+        let pad = self.cell_size * 1e-4 + Vec3::splat(magnitude * 1e-6);
         let tri = self.triangles[t as usize];
         let b = tri.bounds();
-        let lo = self.cell_of(b.min);
-        let hi = self.cell_of(b.max);
+        let lo = self.cell_of(b.min - pad);
+        let hi = self.cell_of(b.max + pad);
         if lo == hi {
             f(self.cell_index(lo));
             return;
         }
-        // Pad each cell a little so rounding never drops a cell the triangle touches.
-        let half = 0.5 * self.cell_size * (1.0 + 1e-4);
+        let half = 0.5 * self.cell_size + pad;
         let vertices = tri.vertices();
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
@@ -138,14 +146,15 @@ fn padded(b: Aabb) -> Aabb {
 }
 
 /// Cells per axis after Cleary & Wyvill (1988): R_a = d_a · ∛(λN / V), which makes cells
-/// near-cubic. Thin axes are first widened to the cube-root cell size of the longest axis
-/// so that flat meshes (a wall, a floor) do not get a vast number of cells.
+/// near-cubic. In V, thin axes count as at least the cube-root cell size of the longest
+/// axis, so that a flat mesh (a wall, a floor) gets about λN cells in its plane and one
+/// across it, instead of a vast number of slivers.
 fn resolution(extent: Vec3, triangles: usize, density: f32) -> UVec3 {
     let target = (density * triangles as f32).max(1.0);
     let floor = extent.max_element() / target.cbrt();
     let e = extent.max(Vec3::splat(floor));
     let k = (target / (e.x * e.y * e.z)).cbrt();
-    let mut r = (e * k)
+    let mut r = (extent * k)
         .floor()
         .max(Vec3::ONE)
         .min(Vec3::splat(MAX_RESOLUTION as f32))
@@ -170,8 +179,11 @@ mod tests {
 
     #[test]
     fn flat_meshes_get_few_cells() {
-        let r = resolution(Vec3::new(2.0, 0.0, 2.0), 2, 5.0);
+        let r = resolution(Vec3::new(2.0, 1e-5, 2.0), 2, 5.0);
         assert_eq!(r.y, 1);
         assert!(r.x * r.z <= 16, "{r}");
+        let r = resolution(Vec3::new(2.0, 4e-5, 2.0), 800, 5.0);
+        assert_eq!(r.y, 1, "{r}");
+        assert!((1000..=4000).contains(&(r.x * r.z)), "{r}");
     }
 }

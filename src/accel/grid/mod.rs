@@ -77,6 +77,16 @@ impl Grid {
         self.bounds
     }
 
+    /// Cells per axis.
+    pub fn resolution(&self) -> UVec3 {
+        self.resolution
+    }
+
+    /// Size of one cell.
+    pub fn cell_size(&self) -> Vec3 {
+        self.cell_size
+    }
+
     /// Figures that describe this grid.
     pub fn stats(&self) -> GridStats {
         let cells = self.cell_start.len() - 1;
