@@ -221,7 +221,13 @@ fn grid_equals_brute_force_on_a_plane_on_a_cell_face() {
     for step in 0..20 {
         let h = 0.5 + 0.05 * step as f32;
         let mut tris = plane(20);
-        let bracket = |y: f32| Triangle::new(Vec3::new(-0.1, y, 0.0), Vec3::new(0.1, y, 0.0), Vec3::new(0.0, y, 0.1));
+        let bracket = |y: f32| {
+            Triangle::new(
+                Vec3::new(-0.1, y, 0.0),
+                Vec3::new(0.1, y, 0.0),
+                Vec3::new(0.0, y, 0.1),
+            )
+        };
         tris.push(bracket(0.25 - h));
         tris.push(bracket(0.25 + h));
         let grid = Grid::build(tris.clone());

@@ -1,0 +1,389 @@
+//! The glTF loader: hierarchy, instancing, cameras, the material table, extensions, errors.
+
+mod common;
+
+use common::{quad_document, write_gltf};
+use glam::{Affine3A, Quat, Vec3};
+use gridtrace::cli::choose_camera;
+use gridtrace::load::{LoadError, load_scene};
+use gridtrace::scene::{MaterialKind, Projection};
+use serde_json::json;
+
+fn approx(a: Vec3, b: Vec3) -> bool {
+    (a - b).abs().max_element() < 1e-5
+}
+
+#[test]
+fn node_transforms_compose_down_the_hierarchy() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = quad_document();
+    // Parent: translate (1, 2, 3). Child: rotate 90° about Y, scale 2. Grandchild: a matrix
+    // translating by (0, 0, 5), holding the mesh.
+    let q = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+    doc["nodes"] = json!([
+        {"translation": [1.0, 2.0, 3.0], "children": [1]},
+        {"rotation": [q.x, q.y, q.z, q.w], "scale": [2.0, 2.0, 2.0], "children": [2]},
+        {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,5,1], "mesh": 0}
+    ]);
+    let loaded = load_scene(&write_gltf(dir.path(), "h.gltf", &doc)).unwrap();
+    let scene = &loaded.scene;
+    assert_eq!(scene.instances.len(), 1);
+    let expected = Affine3A::from_translation(Vec3::new(1.0, 2.0, 3.0))
+        * Affine3A::from_scale_rotation_translation(Vec3::splat(2.0), q, Vec3::ZERO)
+        * Affine3A::from_translation(Vec3::new(0.0, 0.0, 5.0));
+    let got = scene.instances[0].world_from_object;
+    for p in [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z] {
+        assert!(
+            approx(got.transform_point3(p), expected.transform_point3(p)),
+            "{p}"
+        );
+    }
+    // The quad's corner (1, 1, 0): z=5 → rotate about Y maps (1,1,5) to (5,1,-1) → ×2 → + (1,2,3).
+    assert!(approx(
+        got.transform_point3(Vec3::new(1.0, 1.0, 0.0)),
+        Vec3::new(11.0, 4.0, 1.0)
+    ));
+}
+
+#[test]
+fn a_mesh_used_by_many_nodes_is_stored_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = quad_document();
+    doc["nodes"] = json!([
+        {"mesh": 0, "name": "a"},
+        {"mesh": 0, "name": "b", "translation": [3.0, 0.0, 0.0]},
+        {"children": [3]},
+        {"mesh": 0, "name": "c", "translation": [0.0, 3.0, 0.0]}
+    ]);
+    doc["scenes"] = json!([{"nodes": [0, 1, 2]}]);
+    let scene = load_scene(&write_gltf(dir.path(), "i.gltf", &doc))
+        .unwrap()
+        .scene;
+    assert_eq!(scene.meshes.len(), 1);
+    assert_eq!(scene.instances.len(), 3);
+    assert!(scene.instances.iter().all(|i| i.mesh == 0));
+    assert_eq!(scene.instances[2].source, "node 3 'c'");
+    assert_eq!(scene.instanced_triangle_count(), 6);
+    assert!(approx(scene.bounds().max, Vec3::new(4.0, 4.0, 0.0)));
+}
+
+#[test]
+fn cameras_are_listed_in_order_and_chosen_by_name_or_index() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = quad_document();
+    doc["cameras"] = json!([
+        {"name": "Main", "type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 1.5, "znear": 0.1}},
+        {"name": "Top", "type": "orthographic", "orthographic": {"xmag": 2.0, "ymag": 1.0, "znear": 0.01, "zfar": 100.0}}
+    ]);
+    doc["nodes"] = json!([
+        {"mesh": 0},
+        {"camera": 0, "name": "MainNode", "translation": [0.0, 0.0, 10.0]},
+        {"camera": 1, "translation": [0.0, 10.0, 0.0], "rotation": [-0.70710677, 0.0, 0.0, 0.70710677]}
+    ]);
+    doc["scenes"] = json!([{"nodes": [0, 1, 2]}]);
+    let scene = load_scene(&write_gltf(dir.path(), "c.gltf", &doc))
+        .unwrap()
+        .scene;
+    assert_eq!(scene.cameras.len(), 2);
+    let main = choose_camera(&scene, None, None, None).unwrap();
+    assert_eq!(main.name, "Main");
+    assert_eq!(
+        main.projection,
+        Projection::Perspective {
+            yfov: 0.5,
+            aspect_ratio: Some(1.5)
+        }
+    );
+    assert_eq!(main.znear, 0.1);
+    assert!(approx(
+        main.world_from_camera.transform_point3(Vec3::ZERO),
+        Vec3::new(0.0, 0.0, 10.0)
+    ));
+    let top = choose_camera(&scene, Some("Top"), None, None).unwrap();
+    assert_eq!(
+        top.projection,
+        Projection::Orthographic {
+            xmag: 2.0,
+            ymag: 1.0
+        }
+    );
+    // Rotated −90° about X: the camera's −Z view axis points down −Y.
+    assert!(approx(
+        top.world_from_camera.transform_vector3(-Vec3::Z),
+        -Vec3::Y
+    ));
+    assert_eq!(
+        choose_camera(&scene, Some("1"), None, None).unwrap().name,
+        "Top"
+    );
+    assert_eq!(
+        choose_camera(&scene, Some("MainNode"), None, None)
+            .unwrap()
+            .name,
+        "Main"
+    );
+    let err = choose_camera(&scene, Some("Side"), None, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("Side") && err.contains("'Main'") && err.contains("'Top'"),
+        "{err}"
+    );
+    assert!(choose_camera(&scene, Some("7"), None, None).is_err());
+}
+
+#[test]
+fn without_a_camera_a_default_one_frames_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = load_scene(&write_gltf(dir.path(), "n.gltf", &quad_document()))
+        .unwrap()
+        .scene;
+    let camera = choose_camera(&scene, None, None, None).unwrap();
+    let eye = camera.world_from_camera.transform_point3(Vec3::ZERO);
+    assert!(
+        eye.z > 1.0 && eye.x.abs() < 1e-6 && eye.y.abs() < 1e-6,
+        "{eye}"
+    );
+    // The quad's corners are inside the view.
+    let Projection::Perspective { yfov, .. } = camera.projection else {
+        panic!()
+    };
+    for corner in [Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, -1.0, 0.0)] {
+        let d = corner - eye;
+        assert!((d.y / -d.z).abs() < (0.5 * yfov).tan() && (d.x / -d.z).abs() < (0.5 * yfov).tan());
+    }
+}
+
+#[test]
+fn materials_map_by_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = quad_document();
+    doc["extensionsUsed"] = json!([
+        "KHR_materials_emissive_strength",
+        "KHR_materials_transmission",
+        "KHR_materials_ior"
+    ]);
+    doc["materials"] = json!([
+        {"name": "light", "emissiveFactor": [1.0, 0.5, 0.25],
+         "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0}},
+         "pbrMetallicRoughness": {"metallicFactor": 0.0}},
+        {"name": "glass", "pbrMetallicRoughness": {"baseColorFactor": [0.9, 1.0, 0.9, 1.0], "metallicFactor": 1.0},
+         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.5}, "KHR_materials_ior": {"ior": 1.33}}},
+        {"name": "metal", "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.6, 0.2, 1.0]}},
+        {"name": "half metal", "pbrMetallicRoughness": {"metallicFactor": 0.49}},
+        {"name": "plastic", "pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.2, 0.3, 1.0], "metallicFactor": 0.0},
+         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.49}}},
+        {"name": "glass default ior", "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}}},
+        {"name": "one-sided", "doubleSided": false, "pbrMetallicRoughness": {"metallicFactor": 0.0}}
+    ]);
+    let prim = |m: Option<usize>| match m {
+        Some(m) => json!({"attributes": {"POSITION": 0}, "indices": 1, "material": m}),
+        None => json!({"attributes": {"POSITION": 0}, "indices": 1}),
+    };
+    doc["meshes"] =
+        json!([{"primitives": (0..7).map(Some).chain([None]).map(prim).collect::<Vec<_>>()}]);
+    let loaded = load_scene(&write_gltf(dir.path(), "m.gltf", &doc)).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let m = &loaded.scene.materials;
+    assert_eq!(m[0].emission, Vec3::new(4.0, 2.0, 1.0));
+    assert!(matches!(m[0].kind, MaterialKind::Diffuse { albedo } if albedo == Vec3::ONE));
+    assert_eq!(
+        m[1].kind,
+        MaterialKind::Glass {
+            ior: 1.33,
+            tint: Vec3::new(0.9, 1.0, 0.9)
+        }
+    );
+    assert_eq!(m[1].emission, Vec3::ZERO);
+    // glTF's default metallicFactor is 1.
+    assert_eq!(
+        m[2].kind,
+        MaterialKind::Mirror {
+            reflectance: Vec3::new(0.9, 0.6, 0.2)
+        }
+    );
+    assert_eq!(m[3].kind, MaterialKind::Diffuse { albedo: Vec3::ONE });
+    assert_eq!(
+        m[4].kind,
+        MaterialKind::Diffuse {
+            albedo: Vec3::new(0.1, 0.2, 0.3)
+        }
+    );
+    assert_eq!(
+        m[5].kind,
+        MaterialKind::Glass {
+            ior: 1.5,
+            tint: Vec3::ONE
+        }
+    );
+    // glTF's default is single-sided; Blender writes doubleSided: true.
+    assert!(!m[6].double_sided && !m[5].double_sided);
+    // A primitive without a material gets a grey diffuse one.
+    let scene = &loaded.scene;
+    assert_eq!(scene.meshes.len(), 8);
+    let default = &m[scene.meshes[7].material];
+    assert_eq!(
+        default.kind,
+        MaterialKind::Diffuse {
+            albedo: Vec3::splat(0.8)
+        }
+    );
+    assert!(scene.has_emitters());
+}
+
+#[test]
+fn unsupported_required_extensions_are_errors_and_used_ones_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = quad_document();
+    doc["extensionsUsed"] = json!(["EXT_fancy_thing", "KHR_materials_sheen"]);
+    let loaded = load_scene(&write_gltf(dir.path(), "w.gltf", &doc)).unwrap();
+    assert_eq!(loaded.warnings.len(), 1);
+    assert!(
+        loaded.warnings[0].contains("EXT_fancy_thing, KHR_materials_sheen"),
+        "{:?}",
+        loaded.warnings
+    );
+    assert!(loaded.warnings[0].contains("w.gltf"));
+
+    doc["extensionsRequired"] = json!(["EXT_fancy_thing"]);
+    let path = write_gltf(dir.path(), "r.gltf", &doc);
+    let err = load_scene(&path).unwrap_err();
+    assert!(
+        matches!(&err, LoadError::UnsupportedRequiredExtension { names, .. } if names == &["EXT_fancy_thing"])
+    );
+    let message = err.to_string();
+    assert!(
+        message.contains("r.gltf") && message.contains("EXT_fancy_thing"),
+        "{message}"
+    );
+}
+
+#[test]
+fn strips_fans_and_unindexed_triangles_load_and_lines_are_skipped() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = quad_document();
+    doc["meshes"] = json!([{"primitives": [
+        {"attributes": {"POSITION": 0}, "mode": 4},
+        {"attributes": {"POSITION": 0}, "mode": 5},
+        {"attributes": {"POSITION": 0}, "mode": 6},
+        {"attributes": {"POSITION": 0}, "mode": 1}
+    ]}]);
+    let loaded = load_scene(&write_gltf(dir.path(), "s.gltf", &doc)).unwrap();
+    let counts: Vec<usize> = loaded
+        .scene
+        .meshes
+        .iter()
+        .map(|m| m.indices.len())
+        .collect();
+    assert_eq!(counts, vec![1, 2, 2]);
+    // Both leftovers and the skipped line primitive are reported.
+    assert_eq!(loaded.warnings.len(), 2, "{:?}", loaded.warnings);
+    assert!(loaded.warnings.iter().any(|w| w.contains("Lines")));
+    // Normals are computed when the file has none: the fan over the quad faces +Z.
+    assert!(
+        loaded.scene.meshes[2]
+            .normals
+            .iter()
+            .all(|n| (*n - Vec3::Z).length() < 1e-6)
+    );
+}
+
+#[test]
+fn broken_files_give_one_clear_error_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nope.glb");
+    let err = load_scene(&missing).unwrap_err().to_string();
+    assert!(err.contains("nope.glb"), "{err}");
+
+    let mut doc = quad_document();
+    doc["accessors"][1]["count"] = json!(600);
+    let err = load_scene(&write_gltf(dir.path(), "past.gltf", &doc))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("past.gltf") && err.contains("accessor 1"),
+        "{err}"
+    );
+
+    let mut doc = quad_document();
+    doc["meshes"][0]["primitives"][0]["material"] = json!(9);
+    let err = load_scene(&write_gltf(dir.path(), "idx.gltf", &doc))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("idx.gltf") && err.contains("material"),
+        "{err}"
+    );
+
+    let path = dir.path().join("junk.gltf");
+    std::fs::write(&path, b"{ not json").unwrap();
+    let err = load_scene(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("junk.gltf") && err.contains("invalid glTF"),
+        "{err}"
+    );
+
+    let path = dir.path().join("scene.obj");
+    std::fs::write(&path, b"v 0 0 0").unwrap();
+    assert!(
+        load_scene(&path)
+            .unwrap_err()
+            .to_string()
+            .contains("unknown scene format")
+    );
+}
+
+#[test]
+fn out_of_range_vertex_indices_are_rejected() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut buffer = common::quad_buffer();
+    buffer[48..50].copy_from_slice(&7u16.to_le_bytes());
+    let path = write_gltf(dir.path(), "oob.gltf", &quad_document());
+    std::fs::write(dir.path().join("quad.bin"), buffer).unwrap();
+    let err = load_scene(&path).unwrap_err().to_string();
+    assert!(err.contains("oob.gltf") && err.contains("index 7"), "{err}");
+}
+
+#[test]
+fn the_bundled_cornell_box_loads_as_blender_wrote_it() {
+    let loaded = load_scene(std::path::Path::new("assets/cornell_box.glb")).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let scene = &loaded.scene;
+    assert_eq!(scene.instances.len(), 8);
+    assert_eq!(scene.cameras.len(), 1);
+    let light = scene.materials.iter().find(|m| m.name == "Light").unwrap();
+    // Blender: colour (1, 0.85, 0.6) at strength 12, through KHR_materials_emissive_strength.
+    assert!(approx(light.emission, Vec3::new(12.0, 10.2, 7.2)));
+    let red = scene.materials.iter().find(|m| m.name == "Red").unwrap();
+    assert!(
+        matches!(red.kind, MaterialKind::Diffuse { albedo } if approx(albedo, Vec3::new(0.63, 0.065, 0.05)))
+    );
+    // Blender's Z-up box arrives Y-up: the floor at y = 0, the ceiling at y = 2.
+    let b = scene.bounds();
+    assert!(
+        approx(b.min, Vec3::new(-1.0, 0.0, -1.0)) && approx(b.max, Vec3::new(1.0, 2.0, 1.0)),
+        "{b:?}"
+    );
+
+    let spheres = load_scene(std::path::Path::new("assets/cornell_spheres.glb"))
+        .unwrap()
+        .scene;
+    let kinds: Vec<_> = spheres
+        .materials
+        .iter()
+        .map(|m| (m.name.as_str(), m.kind))
+        .collect();
+    assert!(
+        kinds
+            .iter()
+            .any(|(n, k)| *n == "Mirror" && matches!(k, MaterialKind::Mirror { .. })),
+        "{kinds:?}"
+    );
+    assert!(
+        kinds
+            .iter()
+            .any(|(n, k)| *n == "Glass"
+                && matches!(k, MaterialKind::Glass { ior, .. } if *ior == 1.5)),
+        "{kinds:?}"
+    );
+}
