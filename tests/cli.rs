@@ -1,0 +1,222 @@
+//! The `gridtrace` command as a user runs it.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn gridtrace(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gridtrace"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("run gridtrace")
+}
+
+fn asset(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn renders_the_bundled_scene_to_png_and_exr() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = gridtrace(
+        &[
+            &asset("cornell_box.glb"),
+            "-o",
+            "box.png",
+            "--width",
+            "48",
+            "--spp",
+            "4",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    // The camera's aspect ratio is 1: the height follows the width.
+    let png = image::open(dir.path().join("box.png")).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (48, 48));
+    // The red wall is on the left, the green wall on the right.
+    let left = png.get_pixel(3, 24);
+    let right = png.get_pixel(44, 24);
+    let (left, right) = (left.0.map(i32::from), right.0.map(i32::from));
+    assert!(
+        left[0] > left[1] + 40 && right[1] > right[0] + 20,
+        "left {left:?}, right {right:?}"
+    );
+    let summary = stderr(&out);
+    assert!(
+        summary.contains("samples/s") && summary.contains("rays/s"),
+        "{summary}"
+    );
+
+    let out = gridtrace(
+        &[
+            &asset("cornell_spheres.glb"),
+            "-o",
+            "s.exr",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--spp",
+            "2",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("aspect ratio"),
+        "a note says the vertical field of view is kept"
+    );
+    let exr = exr::prelude::read_first_rgba_layer_from_file(
+        dir.path().join("s.exr"),
+        |size, _| vec![[0f32; 4]; size.width() * size.height()],
+        |pixels: &mut Vec<[f32; 4]>, pos, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[pos.y() * 40 + pos.x()] = [r, g, b, a]
+        },
+    )
+    .unwrap();
+    let size = exr.layer_data.size;
+    assert_eq!((size.width(), size.height()), (40, 30));
+    let pixels = &exr.layer_data.channel_data.pixels;
+    assert!(pixels.iter().all(|p| p.iter().all(|c| c.is_finite())));
+    assert!(
+        pixels.iter().any(|p| p[0] > 1.0),
+        "the light is brighter than 1 in linear EXR"
+    );
+    assert!(
+        pixels.iter().all(|p| p[3] == 1.0),
+        "the closed box covers every pixel"
+    );
+}
+
+#[test]
+fn without_output_it_writes_scene_stem_exr_in_the_current_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = gridtrace(
+        &[
+            &asset("cornell_box.glb"),
+            "--width",
+            "8",
+            "--spp",
+            "1",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.path().join("cornell_box.exr").is_file());
+}
+
+#[test]
+fn the_image_does_not_depend_on_the_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = asset("cornell_spheres.glb");
+    for (threads, name) in [("1", "one.exr"), ("2", "two.exr")] {
+        let out = gridtrace(
+            &[
+                &scene,
+                "-o",
+                name,
+                "--width",
+                "24",
+                "--spp",
+                "3",
+                "--threads",
+                threads,
+                "-q",
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    assert_eq!(
+        std::fs::read(dir.path().join("one.exr")).unwrap(),
+        std::fs::read(dir.path().join("two.exr")).unwrap()
+    );
+}
+
+#[test]
+fn errors_are_one_line_with_exit_code_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (&["missing.glb"], "missing.glb"),
+        (&[&asset("cornell_box.glb"), "-o", "out.jpg"], "out.jpg"),
+        (
+            &[&asset("cornell_box.glb"), "--camera", "Nope", "-o", "x.png"],
+            "Nope",
+        ),
+        (
+            &[&asset("cornell_box.glb"), "-o", "no/such/folder/x.png"],
+            "x.png",
+        ),
+    ];
+    for (args, named) in cases {
+        let out = gridtrace(args, dir.path());
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains(named),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "nothing written on error"
+    );
+}
+
+#[test]
+fn a_scene_without_emitters_renders_black_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = common::write_gltf(dir.path(), "dark.gltf", &common::quad_document());
+    let out = gridtrace(
+        &[
+            scene.to_str().unwrap(),
+            "-o",
+            "dark.png",
+            "--width",
+            "8",
+            "--spp",
+            "1",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("no emitters"), "{}", stderr(&out));
+    let png = image::open(dir.path().join("dark.png")).unwrap().to_rgb8();
+    assert!(png.pixels().all(|p| p.0 == [0, 0, 0]));
+}
+
+#[test]
+fn help_explains_every_option() {
+    let out = gridtrace(&["--help"], Path::new("."));
+    assert!(out.status.success());
+    let help = String::from_utf8_lossy(&out.stdout);
+    for option in [
+        "--output",
+        "--spp",
+        "--width",
+        "--height",
+        "--max-depth",
+        "--seed",
+        "--threads",
+        "--camera",
+        "--quiet",
+    ] {
+        assert!(help.contains(option), "--help lacks {option}:\n{help}");
+    }
+}
