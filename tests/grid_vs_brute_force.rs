@@ -179,7 +179,7 @@ fn check_grid(name: &str, triangles: Vec<Triangle>, rays_count: usize, seed: u64
             disagreements.push(format!(
                 "occluded {ray:?}: brute force {}, grid {}",
                 expected.is_some(),
-                !expected.is_some()
+                expected.is_none()
             ));
         }
     }
@@ -231,7 +231,7 @@ fn grid_equals_brute_force_on_a_plane_on_a_cell_face() {
         tris.push(bracket(0.25 - h));
         tris.push(bracket(0.25 + h));
         let grid = Grid::build(tris.clone());
-        if grid.resolution().y % 2 == 0 {
+        if grid.resolution().y.is_multiple_of(2) {
             check_grid("plane on a cell face", tris, 20_000, 6);
             return;
         }

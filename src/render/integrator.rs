@@ -134,7 +134,7 @@ impl Renderer<'_> {
             if depth + 1 >= ROULETTE_DEPTH {
                 let rr = (beta / eta_scale).max_element();
                 if rr < 1.0 {
-                    let q = (1.0 - rr).max(0.05).min(0.95);
+                    let q = (1.0 - rr).clamp(0.05, 0.95);
                     if rng.uniform() < q {
                         break;
                     }

@@ -129,14 +129,16 @@ impl<'a> Renderer<'a> {
         let width = settings.width as usize;
         let spp = settings.spp.max(1);
         let seed = mix64(settings.seed);
-        let rows: Vec<(Vec<(glam::Vec3, f32)>, u64, u64)> = (0..settings.height)
-            .into_par_iter()
-            .map(|y| {
-                let mut row = Vec::with_capacity(width);
+        let mut image = Image::new(settings.width, settings.height);
+        let (rays, nonfinite) = image
+            .pixels
+            .par_chunks_mut(width)
+            .zip(image.alpha.par_chunks_mut(width))
+            .enumerate()
+            .map(|(y, (radiance_row, alpha_row))| {
                 let (mut rays, mut nonfinite) = (0u64, 0u64);
-                for x in 0..settings.width {
-                    let pixel_index = y as u64 * width as u64 + x as u64;
-                    let mut rng = Rng::new(seed, pixel_index);
+                for x in 0..width {
+                    let mut rng = Rng::new(seed, (y * width + x) as u64);
                     let mut acc = PixelAccumulator::default();
                     for _ in 0..spp {
                         let jitter = rng.uniform2();
@@ -147,25 +149,18 @@ impl<'a> Renderer<'a> {
                         acc.add(path.radiance, path.hit);
                     }
                     nonfinite += acc.nonfinite as u64;
-                    row.push(acc.resolve(spp));
+                    (radiance_row[x], alpha_row[x]) = acc.resolve(spp);
                 }
                 on_row();
-                (row, rays, nonfinite)
+                (rays, nonfinite)
             })
-            .collect();
-        let mut image = Image::new(settings.width, settings.height);
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         let mut stats = RenderStats {
             samples: spp as u64 * width as u64 * settings.height as u64,
-            ..Default::default()
+            rays,
+            nonfinite,
+            elapsed: Default::default(),
         };
-        for (y, (row, rays, nonfinite)) in rows.into_iter().enumerate() {
-            for (x, (rgb, alpha)) in row.into_iter().enumerate() {
-                image.pixels[y * width + x] = rgb;
-                image.alpha[y * width + x] = alpha;
-            }
-            stats.rays += rays;
-            stats.nonfinite += nonfinite;
-        }
         stats.elapsed = start.elapsed();
         (image, stats)
     }

@@ -86,7 +86,8 @@ impl Grid {
         let far = t0.max(t1);
         let t_start = ray.t_min.max(near.x).max(near.y).max(near.z);
         let t_end = ray.t_max.min(far.x).min(far.y).min(far.z);
-        if !(t_start <= t_end) {
+        // Written so that a NaN bound also counts as a miss.
+        if t_start > t_end || t_start.is_nan() || t_end.is_nan() {
             return None;
         }
         let cell = self.cell_of(ray.at(t_start)).as_ivec3();
