@@ -93,7 +93,15 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    let mut file = tempfile::NamedTempFile::new_in(parent_dir(path)).map_err(fail)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".gridtrace-").suffix(".tmp");
+    // Temporary files are private by default; an image should get the usual 0666 & !umask.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut file = builder.tempfile_in(parent_dir(path)).map_err(fail)?;
     file.write_all(bytes).map_err(fail)?;
     file.as_file().sync_all().map_err(fail)?;
     file.persist(path).map_err(|e| fail(e.error))?;
@@ -133,5 +141,18 @@ mod tests {
             1,
             "no temporary files left"
         );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn images_are_readable_by_others_like_any_new_file() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.exr");
+        write_image(&path, &Image::new(1, 1)).unwrap();
+        let reference = dir.path().join("plain");
+        std::fs::write(&reference, b"x").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&path), mode(&reference));
     }
 }
