@@ -14,7 +14,7 @@ pub enum LoadError {
         source: std::io::Error,
     },
     /// The extension names no format we read.
-    #[error("{path}: unknown scene format (expected .gltf or .glb)")]
+    #[error("{path}: unknown scene format (expected .gltf, .glb, .ply or .ply.gz)")]
     UnknownFormat {
         /// The scene file.
         path: PathBuf,

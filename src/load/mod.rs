@@ -2,6 +2,7 @@
 
 mod error;
 pub mod gltf;
+pub mod ply;
 
 pub use error::LoadError;
 

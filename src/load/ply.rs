@@ -1,0 +1,208 @@
+//! PLY meshes (ASCII or binary, optionally gzip-compressed) through the `ply-rs-bw` crate.
+//!
+//! A PLY file holds one mesh and nothing else: it becomes one instance with a grey
+//! Lambertian material, without camera or lights.
+
+use std::io::{BufReader, Read};
+use std::path::Path;
+
+use glam::Vec3;
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{Property, PropertyAccess};
+
+use super::{LoadError, Loaded};
+use crate::scene::{Material, Mesh, SceneBuilder};
+
+/// Albedo of the material given to PLY meshes.
+const PLY_ALBEDO: f32 = 0.8;
+
+/// A vertex position; other vertex properties are ignored.
+#[derive(Default)]
+struct PlyVertex(Vec3);
+
+/// A polygon as vertex indices.
+#[derive(Default)]
+struct PlyFace(Vec<i64>);
+
+fn scalar(p: &Property) -> Option<f32> {
+    Some(match *p {
+        Property::Float(v) => v,
+        Property::Double(v) => v as f32,
+        Property::Char(v) => v as f32,
+        Property::UChar(v) => v as f32,
+        Property::Short(v) => v as f32,
+        Property::UShort(v) => v as f32,
+        Property::Int(v) => v as f32,
+        Property::UInt(v) => v as f32,
+        _ => return None,
+    })
+}
+
+impl PropertyAccess for PlyVertex {
+    fn new() -> Self {
+        PlyVertex::default()
+    }
+    fn set_property(&mut self, key: &str, property: Property) -> ply_rs_bw::ply::PropertyAccessResult {
+        let axis = match key {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            _ => return ply_rs_bw::ply::PropertyAccessResult::Ignored,
+        };
+        match scalar(&property) {
+            Some(v) => {
+                self.0[axis] = v;
+                ply_rs_bw::ply::PropertyAccessResult::Set
+            }
+            None => ply_rs_bw::ply::PropertyAccessResult::Ignored,
+        }
+    }
+}
+
+impl PropertyAccess for PlyFace {
+    fn new() -> Self {
+        PlyFace::default()
+    }
+    fn set_property(&mut self, key: &str, property: Property) -> ply_rs_bw::ply::PropertyAccessResult {
+        if key != "vertex_indices" && key != "vertex_index" {
+            return ply_rs_bw::ply::PropertyAccessResult::Ignored;
+        }
+        self.0 = match property {
+            Property::ListChar(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListUChar(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListShort(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListUShort(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListInt(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListUInt(v) => v.into_iter().map(i64::from).collect(),
+            _ => return ply_rs_bw::ply::PropertyAccessResult::Ignored,
+        };
+        ply_rs_bw::ply::PropertyAccessResult::Set
+    }
+}
+
+/// Reads the positions and triangles of a PLY file (`.ply` or `.ply.gz`). Polygons with
+/// more than three corners are split into fans.
+pub fn read_mesh(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
+    let io = |source| LoadError::Io { path: path.to_path_buf(), source };
+    let invalid = |what: String| LoadError::Invalid { path: path.to_path_buf(), what };
+    let mut file = BufReader::new(std::fs::File::open(path).map_err(io)?);
+    let mut magic = [0u8; 2];
+    let gzip = file.get_mut().read(&mut magic).map_err(io)? == 2 && magic == [0x1f, 0x8b];
+    let file = BufReader::new(std::fs::File::open(path).map_err(io)?);
+    let source: Box<dyn Read> = if gzip { Box::new(flate2::read::MultiGzDecoder::new(file)) } else { Box::new(file) };
+    let mut reader = ply_rs_bw::parser::Reader::new(BufReader::new(source));
+
+    let vertex_parser = Parser::<PlyVertex>::new();
+    let face_parser = Parser::<PlyFace>::new();
+    let header = vertex_parser.read_header(&mut reader).map_err(|e| invalid(format!("bad PLY header: {e}")))?;
+    let mut positions = Vec::new();
+    let mut faces = Vec::new();
+    for element in header.elements.values() {
+        match element.name.as_str() {
+            "vertex" => {
+                positions = vertex_parser
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(|e| invalid(format!("bad vertex data: {e}")))?
+                    .into_iter()
+                    .map(|v| v.0)
+                    .collect();
+            }
+            "face" => {
+                faces = face_parser
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(|e| invalid(format!("bad face data: {e}")))?;
+            }
+            _ => {
+                // Skip other elements (edges, materials, ...) by reading them as faces.
+                face_parser
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(|e| invalid(format!("bad '{}' data: {e}", element.name)))?;
+            }
+        }
+    }
+    let n = positions.len() as i64;
+    let mut triangles = Vec::with_capacity(faces.len());
+    for (i, face) in faces.iter().enumerate() {
+        if let Some(bad) = face.0.iter().find(|&&v| v < 0 || v >= n) {
+            return Err(invalid(format!("face {i} uses vertex {bad}, but there are {n} vertices")));
+        }
+        for k in 1..face.0.len().saturating_sub(1) {
+            triangles.push([face.0[0] as u32, face.0[k] as u32, face.0[k + 1] as u32]);
+        }
+    }
+    Ok((positions, triangles))
+}
+
+/// Loads a PLY file as a one-mesh scene.
+pub fn load(path: &Path) -> Result<Loaded, LoadError> {
+    let (positions, indices) = read_mesh(path)?;
+    let mut builder = SceneBuilder::new();
+    let material = builder.add_material(Material::diffuse("ply", Vec3::splat(PLY_ALBEDO)));
+    let normals = Mesh::compute_vertex_normals(&positions, &indices);
+    let name = path.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let mesh = builder.add_full_mesh(Mesh { name: name.clone(), positions, normals, uvs: Vec::new(), indices, material });
+    builder.add_instance(mesh, glam::Affine3A::IDENTITY, name);
+    Ok(Loaded { scene: builder.build(), warnings: Vec::new() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    const ASCII: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+        property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+        0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+
+    #[test]
+    fn reads_ascii_plain_and_gzipped_and_splits_quads() {
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("q.ply");
+        std::fs::write(&plain, ASCII).unwrap();
+        let gz = dir.path().join("q.ply.gz");
+        let mut enc = flate2::write::GzEncoder::new(std::fs::File::create(&gz).unwrap(), flate2::Compression::fast());
+        enc.write_all(ASCII.as_bytes()).unwrap();
+        enc.finish().unwrap();
+        for path in [plain, gz] {
+            let (p, t) = read_mesh(&path).unwrap();
+            assert_eq!(p.len(), 4);
+            assert_eq!(t, vec![[0, 1, 2], [0, 2, 3]]);
+        }
+    }
+
+    #[test]
+    fn reads_binary_little_endian_with_double_positions_and_extra_properties() {
+        let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty double x\n\
+            property double y\nproperty double z\nproperty uchar red\nelement face 1\n\
+            property list uchar uint vertex_indices\nend_header\n"
+            .to_vec();
+        for (x, y) in [(0.0f64, 0.0f64), (2.0, 0.0), (0.0, 2.0)] {
+            for c in [x, y, 0.5] {
+                bytes.extend_from_slice(&c.to_le_bytes());
+            }
+            bytes.push(7);
+        }
+        bytes.push(3);
+        for i in [0u32, 1, 2] {
+            bytes.extend_from_slice(&i.to_le_bytes());
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("b.ply");
+        std::fs::write(&path, bytes).unwrap();
+        let (p, t) = read_mesh(&path).unwrap();
+        assert_eq!(p[1], Vec3::new(2.0, 0.0, 0.5));
+        assert_eq!(t, vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn rejects_out_of_range_indices_and_garbage_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.ply");
+        std::fs::write(&path, ASCII.replace("4 0 1 2 3", "3 0 1 9")).unwrap();
+        let err = read_mesh(&path).unwrap_err().to_string();
+        assert!(err.contains("bad.ply") && err.contains("vertex 9"), "{err}");
+        std::fs::write(&path, "not a ply file").unwrap();
+        let err = read_mesh(&path).unwrap_err().to_string();
+        assert!(err.contains("bad.ply") && err.contains("header"), "{err}");
+    }
+}

@@ -1,0 +1,113 @@
+//! Embree 4 through its C API (`embree4-sys`). The `embree4-rs` wrapper keeps the scene
+//! handle private and checks the device error after every ray, so the raw calls are used.
+
+use std::ptr::{null, null_mut};
+use std::sync::atomic::{AtomicIsize, Ordering};
+
+use embree4_sys::*;
+use gridtrace::accel::Ray;
+
+use super::Mesh;
+
+/// Bytes Embree holds, from its memory-monitor callback.
+static EMBREE_BYTES: AtomicIsize = AtomicIsize::new(0);
+
+unsafe extern "C" fn count_memory(_user: *mut std::os::raw::c_void, bytes: isize, _post: bool) -> bool {
+    EMBREE_BYTES.fetch_add(bytes, Ordering::Relaxed);
+    true
+}
+
+/// A committed Embree scene holding one triangle mesh.
+pub struct Embree {
+    device: RTCDevice,
+    scene: RTCScene,
+    /// Bytes the device allocated while building this scene.
+    pub bytes: usize,
+}
+
+// SAFETY: Embree documents committed scenes as safe to query from many threads at once;
+// nothing mutates the scene after `build` returns, and `Drop` needs `&mut self`.
+unsafe impl Sync for Embree {}
+unsafe impl Send for Embree {}
+
+impl Embree {
+    pub fn build(mesh: &Mesh) -> Embree {
+        // SAFETY: plain Embree API use: the buffers returned by rtcSetNewGeometryBuffer are
+        // owned by the geometry and sized for exactly the items written into them.
+        unsafe {
+            let device = rtcNewDevice(null());
+            assert!(!device.is_null(), "rtcNewDevice failed");
+            rtcSetDeviceMemoryMonitorFunction(device, Some(count_memory), null_mut());
+            let before = EMBREE_BYTES.load(Ordering::Relaxed);
+            let scene = rtcNewScene(device);
+            let geometry = rtcNewGeometry(device, RTCGeometryType::TRIANGLE);
+            let vertices = rtcSetNewGeometryBuffer(geometry, RTCBufferType::VERTEX, 0, RTCFormat::FLOAT3, 12, mesh.positions.len())
+                as *mut f32;
+            for (i, p) in mesh.positions.iter().enumerate() {
+                *vertices.add(3 * i) = p.x;
+                *vertices.add(3 * i + 1) = p.y;
+                *vertices.add(3 * i + 2) = p.z;
+            }
+            let indices = rtcSetNewGeometryBuffer(geometry, RTCBufferType::INDEX, 0, RTCFormat::UINT3, 12, mesh.indices.len())
+                as *mut u32;
+            for (i, t) in mesh.indices.iter().enumerate() {
+                for k in 0..3 {
+                    *indices.add(3 * i + k) = t[k];
+                }
+            }
+            rtcCommitGeometry(geometry);
+            rtcAttachGeometry(scene, geometry);
+            rtcReleaseGeometry(geometry);
+            rtcCommitScene(scene);
+            assert_eq!(rtcGetDeviceError(device), RTCError::NONE, "Embree build failed");
+            let bytes = (EMBREE_BYTES.load(Ordering::Relaxed) - before).max(0) as usize;
+            Embree { device, scene, bytes }
+        }
+    }
+
+    fn rtc_ray(ray: &Ray) -> RTCRay {
+        RTCRay {
+            org_x: ray.origin.x,
+            org_y: ray.origin.y,
+            org_z: ray.origin.z,
+            tnear: ray.t_min,
+            dir_x: ray.direction.x,
+            dir_y: ray.direction.y,
+            dir_z: ray.direction.z,
+            time: 0.0,
+            tfar: ray.t_max,
+            mask: u32::MAX,
+            id: 0,
+            flags: 0,
+        }
+    }
+
+    /// Closest hit (`rtcIntersect1`): (t, triangle index).
+    pub fn intersect(&self, ray: &Ray) -> Option<(f32, u32)> {
+        let mut rayhit = RTCRayHit {
+            ray: Self::rtc_ray(ray),
+            hit: RTCHit { Ng_x: 0.0, Ng_y: 0.0, Ng_z: 0.0, u: 0.0, v: 0.0, primID: u32::MAX, geomID: u32::MAX, instID: [u32::MAX] },
+        };
+        // SAFETY: the scene is committed and `rayhit` is a valid, exclusively borrowed struct.
+        unsafe { rtcIntersect1(self.scene, &mut rayhit, null_mut()) };
+        (rayhit.hit.geomID != u32::MAX).then_some((rayhit.ray.tfar, rayhit.hit.primID))
+    }
+
+    /// Any hit (`rtcOccluded1`).
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let mut r = Self::rtc_ray(ray);
+        // SAFETY: as in `intersect`. Embree sets tfar to −∞ when the ray is occluded.
+        unsafe { rtcOccluded1(self.scene, &mut r, null_mut()) };
+        r.tfar == f32::NEG_INFINITY
+    }
+}
+
+impl Drop for Embree {
+    fn drop(&mut self) {
+        // SAFETY: both handles were created in `build` and are released once.
+        unsafe {
+            rtcReleaseScene(self.scene);
+            rtcReleaseDevice(self.device);
+        }
+    }
+}

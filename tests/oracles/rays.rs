@@ -1,0 +1,60 @@
+//! The two fixed-seed ray sets the accelerators are compared and timed on.
+
+use glam::Vec3;
+use gridtrace::accel::{Ray, Triangle};
+use gridtrace::render::sampling::{Frame, Rng, cosine_hemisphere, uniform_triangle};
+use gridtrace::scene::Aabb;
+
+fn unit_vector(rng: &mut Rng) -> Vec3 {
+    let z = 1.0 - 2.0 * rng.uniform();
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * rng.uniform();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Rays from a sphere around the box (radius: the box's diagonal) towards uniform random
+/// points inside it, as primary rays approach a model.
+pub fn outside_rays(bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng::new(seed, 1);
+    let center = bounds.center();
+    let radius = bounds.extent().length();
+    (0..count)
+        .map(|_| {
+            let origin = center + radius * unit_vector(&mut rng);
+            let target = bounds.min + Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * bounds.extent();
+            Ray::new(origin, (target - origin).normalize())
+        })
+        .collect()
+}
+
+/// How far bounce rays start off the surface: the renderer's own rule (1e-5 of the scene's
+/// size), so the oracles see the rays the renderer really traces.
+pub fn surface_offset(bounds: &Aabb) -> f32 {
+    1e-5 * (bounds.extent().length() + bounds.min.abs().max(bounds.max.abs()).max_element())
+}
+
+/// 'Bounce' rays: from uniform random points of random triangles, in cosine-distributed
+/// directions about the geometric normal, on either side at random, starting just off the
+/// surface on that side, as the renderer's secondary rays do.
+pub fn bounce_rays(triangles: &[Triangle], bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng::new(seed, 2);
+    let live: Vec<&Triangle> = triangles.iter().filter(|t| !t.is_degenerate()).collect();
+    let offset = surface_offset(bounds);
+    (0..count)
+        .map(|_| {
+            let tri = live[((rng.uniform() * live.len() as f32) as usize).min(live.len() - 1)];
+            let b = uniform_triangle(rng.uniform2());
+            let p = tri.v0 + b.x * tri.e1 + b.y * tri.e2;
+            let side = if rng.uniform() < 0.5 { 1.0 } else { -1.0 };
+            let n = side * tri.e1.cross(tri.e2).normalize();
+            let direction = Frame::from_normal(n).to_world(cosine_hemisphere(rng.uniform2()));
+            Ray::new(p + offset * n, direction.normalize())
+        })
+        .collect()
+}
+
+/// The same rays cut to segments of random length up to `max_length`, as shadow rays are.
+pub fn segments(rays: &[Ray], max_length: f32, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng::new(seed, 3);
+    rays.iter().map(|r| r.with_t_max(max_length * rng.uniform().max(1e-3))).collect()
+}

@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Everything the tests and benchmarks need beyond the Rust toolchain: Embree 4 (with
+# libclang for its bindings) and the Stanford dragon. Idempotent; safe to run every time.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+tools/install-embree.sh
+tools/fetch-dragon.sh
