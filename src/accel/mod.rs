@@ -6,7 +6,7 @@ mod instances;
 mod ray;
 mod triangle;
 
-pub use grid::{Grid, GridHit, GridStats};
+pub use grid::{Grid, GridHit, GridStats, TraversalCounts, TraversalStats};
 pub use instances::{SceneAccel, SceneHit};
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};

@@ -42,7 +42,11 @@ impl PropertyAccess for PlyVertex {
     fn new() -> Self {
         PlyVertex::default()
     }
-    fn set_property(&mut self, key: &str, property: Property) -> ply_rs_bw::ply::PropertyAccessResult {
+    fn set_property(
+        &mut self,
+        key: &str,
+        property: Property,
+    ) -> ply_rs_bw::ply::PropertyAccessResult {
         let axis = match key {
             "x" => 0,
             "y" => 1,
@@ -63,7 +67,11 @@ impl PropertyAccess for PlyFace {
     fn new() -> Self {
         PlyFace::default()
     }
-    fn set_property(&mut self, key: &str, property: Property) -> ply_rs_bw::ply::PropertyAccessResult {
+    fn set_property(
+        &mut self,
+        key: &str,
+        property: Property,
+    ) -> ply_rs_bw::ply::PropertyAccessResult {
         if key != "vertex_indices" && key != "vertex_index" {
             return ply_rs_bw::ply::PropertyAccessResult::Ignored;
         }
@@ -83,18 +91,30 @@ impl PropertyAccess for PlyFace {
 /// Reads the positions and triangles of a PLY file (`.ply` or `.ply.gz`). Polygons with
 /// more than three corners are split into fans.
 pub fn read_mesh(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
-    let io = |source| LoadError::Io { path: path.to_path_buf(), source };
-    let invalid = |what: String| LoadError::Invalid { path: path.to_path_buf(), what };
+    let io = |source| LoadError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let invalid = |what: String| LoadError::Invalid {
+        path: path.to_path_buf(),
+        what,
+    };
     let mut file = BufReader::new(std::fs::File::open(path).map_err(io)?);
     let mut magic = [0u8; 2];
     let gzip = file.get_mut().read(&mut magic).map_err(io)? == 2 && magic == [0x1f, 0x8b];
     let file = BufReader::new(std::fs::File::open(path).map_err(io)?);
-    let source: Box<dyn Read> = if gzip { Box::new(flate2::read::MultiGzDecoder::new(file)) } else { Box::new(file) };
+    let source: Box<dyn Read> = if gzip {
+        Box::new(flate2::read::MultiGzDecoder::new(file))
+    } else {
+        Box::new(file)
+    };
     let mut reader = ply_rs_bw::parser::Reader::new(BufReader::new(source));
 
     let vertex_parser = Parser::<PlyVertex>::new();
     let face_parser = Parser::<PlyFace>::new();
-    let header = vertex_parser.read_header(&mut reader).map_err(|e| invalid(format!("bad PLY header: {e}")))?;
+    let header = vertex_parser
+        .read_header(&mut reader)
+        .map_err(|e| invalid(format!("bad PLY header: {e}")))?;
     let mut positions = Vec::new();
     let mut faces = Vec::new();
     for element in header.elements.values() {
@@ -124,7 +144,9 @@ pub fn read_mesh(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
     let mut triangles = Vec::with_capacity(faces.len());
     for (i, face) in faces.iter().enumerate() {
         if let Some(bad) = face.0.iter().find(|&&v| v < 0 || v >= n) {
-            return Err(invalid(format!("face {i} uses vertex {bad}, but there are {n} vertices")));
+            return Err(invalid(format!(
+                "face {i} uses vertex {bad}, but there are {n} vertices"
+            )));
         }
         for k in 1..face.0.len().saturating_sub(1) {
             triangles.push([face.0[0] as u32, face.0[k] as u32, face.0[k + 1] as u32]);
@@ -139,10 +161,22 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
     let mut builder = SceneBuilder::new();
     let material = builder.add_material(Material::diffuse("ply", Vec3::splat(PLY_ALBEDO)));
     let normals = Mesh::compute_vertex_normals(&positions, &indices);
-    let name = path.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    let mesh = builder.add_full_mesh(Mesh { name: name.clone(), positions, normals, uvs: Vec::new(), indices, material });
+    let name = path
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let mesh = builder.add_full_mesh(Mesh {
+        name: name.clone(),
+        positions,
+        normals,
+        uvs: Vec::new(),
+        indices,
+        material,
+    });
     builder.add_instance(mesh, glam::Affine3A::IDENTITY, name);
-    Ok(Loaded { scene: builder.build(), warnings: Vec::new() })
+    Ok(Loaded {
+        scene: builder.build(),
+        warnings: Vec::new(),
+    })
 }
 
 #[cfg(test)]
@@ -160,7 +194,10 @@ mod tests {
         let plain = dir.path().join("q.ply");
         std::fs::write(&plain, ASCII).unwrap();
         let gz = dir.path().join("q.ply.gz");
-        let mut enc = flate2::write::GzEncoder::new(std::fs::File::create(&gz).unwrap(), flate2::Compression::fast());
+        let mut enc = flate2::write::GzEncoder::new(
+            std::fs::File::create(&gz).unwrap(),
+            flate2::Compression::fast(),
+        );
         enc.write_all(ASCII.as_bytes()).unwrap();
         enc.finish().unwrap();
         for path in [plain, gz] {
@@ -172,10 +209,11 @@ mod tests {
 
     #[test]
     fn reads_binary_little_endian_with_double_positions_and_extra_properties() {
-        let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty double x\n\
+        let mut bytes =
+            b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty double x\n\
             property double y\nproperty double z\nproperty uchar red\nelement face 1\n\
             property list uchar uint vertex_indices\nend_header\n"
-            .to_vec();
+                .to_vec();
         for (x, y) in [(0.0f64, 0.0f64), (2.0, 0.0), (0.0, 2.0)] {
             for c in [x, y, 0.5] {
                 bytes.extend_from_slice(&c.to_le_bytes());

@@ -1,16 +1,16 @@
-//! Grid construction: resolution, then count → prefix sum → fill into compact cell storage.
+//! Grid construction: resolution, then count → prefix sums → fill into compact storage.
 
 use glam::{UVec3, Vec3};
 
 use super::overlap::triangle_overlaps_box;
-use super::{DEFAULT_DENSITY, Grid};
+use super::{DEFAULT_DENSITY, Grid, MACRO_SHIFT};
 use crate::accel::Triangle;
 use crate::scene::Aabb;
 
 /// Most cells along one axis.
-const MAX_RESOLUTION: u32 = 1024;
-/// Most cells in one grid (512 MiB of offsets would be absurd for any mesh we render).
-const MAX_CELLS: u64 = 1 << 27;
+const MAX_RESOLUTION: u32 = 2048;
+/// Most cells in one grid (the per-cell build counters would otherwise be absurd).
+const MAX_CELLS: u64 = 1 << 28;
 
 impl Grid {
     /// Builds a grid over `triangles` with the default density.
@@ -20,8 +20,8 @@ impl Grid {
 
     /// Builds a grid with about `density` cells per triangle.
     ///
-    /// Degenerate triangles (no area, or non-finite corners) are kept in the triangle list,
-    /// so indices still match the mesh, but go into no cell and so are never hit.
+    /// Degenerate triangles (no area, or non-finite corners) go into no cell and so are never
+    /// hit; hits still report indices into `triangles`.
     pub fn build_with_density(triangles: Vec<Triangle>, density: f32) -> Grid {
         let live: Vec<u32> = (0..triangles.len() as u32)
             .filter(|&i| !triangles[i as usize].is_degenerate())
@@ -29,68 +29,103 @@ impl Grid {
         let tight = live
             .iter()
             .fold(Aabb::EMPTY, |b, &i| b.union(triangles[i as usize].bounds()));
-        if tight.is_empty() {
-            return Grid::empty(triangles);
-        }
-        let bounds = padded(tight);
-        let resolution = resolution(bounds.extent(), live.len(), density);
+        let (bounds, resolution) = if tight.is_empty() {
+            (
+                Aabb {
+                    min: Vec3::ZERO,
+                    max: Vec3::ONE,
+                },
+                UVec3::ONE,
+            )
+        } else {
+            let bounds = padded(tight);
+            (bounds, resolution(bounds.extent(), live.len(), density))
+        };
         let cell_size = bounds.extent() / resolution.as_vec3();
         let mut grid = Grid {
             bounds,
             resolution,
             cell_size,
             inv_cell_size: cell_size.recip(),
-            cell_start: Vec::new(),
-            references: Vec::new(),
-            triangles,
+            occupancy: Vec::new(),
+            rank: Vec::new(),
+            offsets: Vec::new(),
+            cell_triangles: Vec::new(),
+            cell_triangle_ids: Vec::new(),
+            macro_resolution: UVec3::ONE,
+            macro_occupancy: Vec::new(),
+            triangle_count: triangles.len(),
+            inserted: live.len(),
         };
-        grid.insert(&live);
+        grid.insert(&triangles, &live);
         grid
     }
 
-    fn empty(triangles: Vec<Triangle>) -> Grid {
-        Grid {
-            bounds: Aabb {
-                min: Vec3::ZERO,
-                max: Vec3::ONE,
-            },
-            resolution: UVec3::ONE,
-            cell_size: Vec3::ONE,
-            inv_cell_size: Vec3::ONE,
-            cell_start: vec![0, 0],
-            references: Vec::new(),
-            triangles,
-        }
-    }
-
-    /// Fills the compact cell storage in two passes over the triangles (count, then place).
-    fn insert(&mut self, live: &[u32]) {
-        let cells = (self.resolution.x * self.resolution.y * self.resolution.z) as usize;
-        let mut counts = vec![0u32; cells + 1];
+    /// Fills the compact storage in two passes over the triangles: count the references of
+    /// every cell, then place each triangle after its cell's prefix sum.
+    fn insert(&mut self, triangles: &[Triangle], live: &[u32]) {
+        let cells = self.cell_count();
+        let mut counts = vec![0u32; cells];
         for &t in live {
-            self.for_each_overlapped_cell(t, |cell| counts[cell] += 1);
+            self.for_each_overlapped_cell(&triangles[t as usize], |cell| counts[cell] += 1);
         }
-        // Exclusive prefix sum: counts becomes the start offset of each cell.
+        // Occupancy bits, ranks and macrocell bits from the counts.
+        let r = self.resolution;
+        self.macro_resolution = (r + UVec3::splat((1 << MACRO_SHIFT) - 1)) >> MACRO_SHIFT as u32;
+        let m = self.macro_resolution;
+        self.occupancy = vec![0; cells.div_ceil(64)];
+        self.macro_occupancy = vec![0; ((m.x * m.y * m.z) as usize).div_ceil(64)];
+        for (i, &n) in counts.iter().enumerate() {
+            if n > 0 {
+                self.occupancy[i >> 6] |= 1 << (i & 63);
+                let c = UVec3::new(
+                    i as u32 % r.x,
+                    (i as u32 / r.x) % r.y,
+                    i as u32 / (r.x * r.y),
+                );
+                let mc = c >> MACRO_SHIFT as u32;
+                let mi = (mc.x + m.x * (mc.y + m.y * mc.z)) as usize;
+                self.macro_occupancy[mi >> 6] |= 1 << (mi & 63);
+            }
+        }
+        let mut occupied = 0u32;
+        self.rank = self
+            .occupancy
+            .iter()
+            .map(|w| {
+                let before = occupied;
+                occupied += w.count_ones();
+                before
+            })
+            .collect();
+        // Offsets of the occupied cells; `counts` becomes each cell's next free slot.
+        self.offsets = Vec::with_capacity(occupied as usize + 1);
         let mut total = 0u32;
-        for c in counts.iter_mut() {
-            let n = *c;
-            *c = total;
-            total += n;
+        for n in counts.iter_mut().filter(|n| **n > 0) {
+            self.offsets.push(total);
+            let here = *n;
+            *n = total;
+            total += here;
         }
-        let mut next = counts.clone();
-        let mut references = vec![0u32; total as usize];
+        self.offsets.push(total);
+        let mut cell_triangles =
+            vec![Triangle::new(Vec3::ZERO, Vec3::ZERO, Vec3::ZERO); total as usize];
+        let mut cell_triangle_ids = vec![0; total as usize];
         for &t in live {
-            self.for_each_overlapped_cell(t, |cell| {
-                references[next[cell] as usize] = t;
-                next[cell] += 1;
+            let tri = triangles[t as usize];
+            self.for_each_overlapped_cell(&tri, |cell| {
+                let slot = counts[cell] as usize;
+                cell_triangles[slot] = tri;
+                cell_triangle_ids[slot] = t;
+                counts[cell] += 1;
             });
         }
-        self.cell_start = counts;
-        self.references = references;
+        self.cell_triangles = cell_triangles;
+        self.cell_triangle_ids = cell_triangle_ids;
     }
 
     /// Calls `f` with the index of every cell the triangle overlaps.
-    fn for_each_overlapped_cell(&self, t: u32, mut f: impl FnMut(usize)) {
+    fn for_each_overlapped_cell(&self, tri: &Triangle, mut f: impl FnMut(usize)) {
         // Pad cells a little so rounding never drops a cell the triangle touches: a triangle
         // lying on a cell face belongs to the cells on both sides.
         let magnitude = self
@@ -100,7 +135,6 @@ impl Grid {
             .max(self.bounds.max.abs())
             .max_element();
         let pad = self.cell_size * 1e-4 + Vec3::splat(magnitude * 1e-6);
-        let tri = self.triangles[t as usize];
         let b = tri.bounds();
         let lo = self.cell_of(b.min - pad);
         let hi = self.cell_of(b.max + pad);

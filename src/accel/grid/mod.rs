@@ -1,21 +1,32 @@
 //! A uniform grid over one mesh's triangles, in object space.
 //!
-//! Cells are stored compactly (Lagae & Dutré 2008): one offset per cell into a single flat
-//! array of triangle references. Triangles are inserted only into the cells they really
-//! overlap (triangle–box separating-axis test), and traversal is the 3D-DDA of
-//! Amanatides & Woo (1987), accepting a hit only if it lies within the current cell.
+//! Triangles go only into the cells they really overlap (triangle–box separating-axis
+//! test). Storage is compact (after Lagae & Dutré 2008): one occupancy bit per cell, a
+//! running count of occupied cells per 64-bit word (so an occupied cell's rank is one
+//! popcount away), offsets for occupied cells only, and the triangles themselves copied in
+//! cell order, so a cell's triangles sit together in memory. A second bit array marks the
+//! occupied macrocells of `2^MACRO_SHIFT`³ cells, which lets the walk cross empty space in
+//! large steps. Traversal is the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if
+//! it lies within the current cell.
 
 mod build;
 mod overlap;
 mod traverse;
 
-use glam::{UVec3, Vec3};
+pub use traverse::{TraversalCounts, TraversalStats};
+
+use std::ops::Range;
+
+use glam::{IVec3, UVec3, Vec3};
 
 use super::Triangle;
 use crate::scene::Aabb;
 
 /// Cells per triangle aimed for by the resolution heuristic (λ in Cleary & Wyvill 1988).
 pub const DEFAULT_DENSITY: f32 = 5.0;
+
+/// A macrocell is 2^MACRO_SHIFT cells along each axis.
+const MACRO_SHIFT: i32 = 3;
 
 /// A uniform grid accelerating ray queries against one triangle list.
 #[derive(Clone, Debug)]
@@ -28,12 +39,24 @@ pub struct Grid {
     cell_size: Vec3,
     /// `1 / cell_size`.
     inv_cell_size: Vec3,
-    /// `cell_start[c]..cell_start[c + 1]` indexes `references` for cell `c`.
-    cell_start: Vec<u32>,
-    /// Triangle indices, grouped by cell.
-    references: Vec<u32>,
-    /// The triangles, indexed as in the mesh.
-    triangles: Vec<Triangle>,
+    /// One bit per cell (x fastest, then y, then z): set when the cell holds a triangle.
+    occupancy: Vec<u64>,
+    /// Occupied cells before each word of `occupancy`.
+    rank: Vec<u32>,
+    /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes `cell_triangles`.
+    offsets: Vec<u32>,
+    /// The triangles of every occupied cell, cell after cell.
+    cell_triangles: Vec<Triangle>,
+    /// The mesh index of each entry of `cell_triangles`.
+    cell_triangle_ids: Vec<u32>,
+    /// Macrocells per axis.
+    macro_resolution: UVec3,
+    /// One bit per macrocell: set when any of its cells holds a triangle.
+    macro_occupancy: Vec<u64>,
+    /// Triangles given to the build, degenerate ones included.
+    triangle_count: usize,
+    /// Triangles that went into cells (the non-degenerate ones).
+    inserted: usize,
 }
 
 /// A closest hit in a grid.
@@ -62,16 +85,11 @@ pub struct GridStats {
     pub references: usize,
     /// Fraction of cells that hold no triangle.
     pub empty_fraction: f64,
-    /// Bytes held by the structure, triangles included.
+    /// Bytes held by the structure, triangle copies included.
     pub bytes: usize,
 }
 
 impl Grid {
-    /// The triangles the grid was built over.
-    pub fn triangles(&self) -> &[Triangle] {
-        &self.triangles
-    }
-
     /// Bounds of the grid's cells.
     pub fn bounds(&self) -> Aabb {
         self.bounds
@@ -87,33 +105,29 @@ impl Grid {
         self.cell_size
     }
 
+    /// Number of cells.
+    fn cell_count(&self) -> usize {
+        (self.resolution.x * self.resolution.y * self.resolution.z) as usize
+    }
+
     /// Figures that describe this grid.
     pub fn stats(&self) -> GridStats {
-        let cells = self.cell_start.len() - 1;
-        let empty = self.cell_start.windows(2).filter(|w| w[0] == w[1]).count();
-        let inserted = self.triangles.iter().filter(|t| !t.is_degenerate()).count();
+        let cells = self.cell_count();
+        let occupied = self.offsets.len() - 1;
         GridStats {
             resolution: self.resolution,
             cells,
-            triangles: inserted,
-            references: self.references.len(),
-            empty_fraction: if cells == 0 {
-                1.0
-            } else {
-                empty as f64 / cells as f64
-            },
+            triangles: self.inserted,
+            references: self.cell_triangles.len(),
+            empty_fraction: 1.0 - occupied as f64 / cells as f64,
             bytes: std::mem::size_of::<Grid>()
-                + self.cell_start.len() * 4
-                + self.references.len() * 4
-                + self.triangles.len() * std::mem::size_of::<Triangle>(),
+                + std::mem::size_of_val(self.occupancy.as_slice())
+                + std::mem::size_of_val(self.rank.as_slice())
+                + std::mem::size_of_val(self.offsets.as_slice())
+                + std::mem::size_of_val(self.cell_triangles.as_slice())
+                + std::mem::size_of_val(self.cell_triangle_ids.as_slice())
+                + std::mem::size_of_val(self.macro_occupancy.as_slice()),
         }
-    }
-
-    /// Triangle references of the cell at integer coordinates `c`.
-    #[inline]
-    fn cell(&self, c: UVec3) -> &[u32] {
-        let i = self.cell_index(c);
-        &self.references[self.cell_start[i] as usize..self.cell_start[i + 1] as usize]
     }
 
     #[inline]
@@ -121,42 +135,104 @@ impl Grid {
         (c.x + self.resolution.x * (c.y + self.resolution.y * c.z)) as usize
     }
 
+    /// Where the triangles of cell `index` lie in `cell_triangles`; `None` for empty cells.
+    #[inline]
+    fn cell_range(&self, index: usize) -> Option<Range<usize>> {
+        let word = self.occupancy[index >> 6];
+        let bit = 1u64 << (index & 63);
+        if word & bit == 0 {
+            return None;
+        }
+        let k = self.rank[index >> 6] as usize + (word & (bit - 1)).count_ones() as usize;
+        Some(self.offsets[k] as usize..self.offsets[k + 1] as usize)
+    }
+
+    /// True when the macrocell holding cell `c` holds a triangle.
+    #[inline]
+    fn macro_occupied(&self, c: IVec3) -> bool {
+        let m = (c >> MACRO_SHIFT).as_uvec3();
+        let index =
+            (m.x + self.macro_resolution.x * (m.y + self.macro_resolution.y * m.z)) as usize;
+        self.macro_occupancy[index >> 6] & (1 << (index & 63)) != 0
+    }
+
     /// Checks the structure's invariants; returns a description of the first broken one.
     pub fn validate(&self) -> Result<(), String> {
-        let cells = (self.resolution.x * self.resolution.y * self.resolution.z) as usize;
-        if self.cell_start.len() != cells + 1 {
+        let cells = self.cell_count();
+        if self.occupancy.len() != cells.div_ceil(64) || self.rank.len() != self.occupancy.len() {
             return Err(format!(
-                "{} offsets for {cells} cells",
-                self.cell_start.len()
+                "{} occupancy words and {} ranks for {cells} cells",
+                self.occupancy.len(),
+                self.rank.len()
             ));
         }
-        if self.cell_start.windows(2).any(|w| w[0] > w[1]) {
-            return Err("cell offsets decrease".into());
+        let mut occupied = 0u32;
+        for (w, &word) in self.occupancy.iter().enumerate() {
+            if self.rank[w] != occupied {
+                return Err(format!(
+                    "rank of word {w} is {}, expected {occupied}",
+                    self.rank[w]
+                ));
+            }
+            occupied += word.count_ones();
         }
-        if *self.cell_start.last().unwrap() as usize != self.references.len() {
-            return Err("last offset is not the reference count".into());
+        if self.offsets.len() != occupied as usize + 1 {
+            return Err(format!(
+                "{} offsets for {occupied} occupied cells",
+                self.offsets.len()
+            ));
         }
-        if let Some(r) = self
-            .references
-            .iter()
-            .find(|&&r| r as usize >= self.triangles.len())
+        if self.offsets.windows(2).any(|w| w[0] >= w[1]) {
+            return Err("an occupied cell is empty or offsets decrease".into());
+        }
+        if *self.offsets.last().unwrap() as usize != self.cell_triangles.len()
+            || self.cell_triangle_ids.len() != self.cell_triangles.len()
         {
-            return Err(format!(
-                "reference {r} past {} triangles",
-                self.triangles.len()
-            ));
+            return Err("offsets, triangle copies and ids disagree in length".into());
         }
-        for (i, tri) in self.triangles.iter().enumerate() {
-            if tri.is_degenerate() {
-                continue;
+        let mut seen = vec![false; self.triangle_count];
+        for z in 0..self.resolution.z {
+            for y in 0..self.resolution.y {
+                for x in 0..self.resolution.x {
+                    let c = UVec3::new(x, y, z);
+                    let Some(range) = self.cell_range(self.cell_index(c)) else {
+                        continue;
+                    };
+                    if !self.macro_occupied(c.as_ivec3()) {
+                        return Err(format!(
+                            "cell {c} is occupied but its macrocell is marked empty"
+                        ));
+                    }
+                    let lo = self.bounds.min + c.as_vec3() * self.cell_size;
+                    let cell = Aabb {
+                        min: lo - self.cell_size * 1e-3,
+                        max: lo + self.cell_size * 1.001,
+                    };
+                    for k in range {
+                        let id = self.cell_triangle_ids[k] as usize;
+                        let b = self.cell_triangles[k].bounds();
+                        if id >= self.triangle_count {
+                            return Err(format!(
+                                "cell {c} refers to triangle {id} of {}",
+                                self.triangle_count
+                            ));
+                        }
+                        if b.max.cmplt(cell.min).any() || b.min.cmpgt(cell.max).any() {
+                            return Err(format!(
+                                "triangle {id} is stored in cell {c}, which it does not touch"
+                            ));
+                        }
+                        seen[id] = true;
+                    }
+                }
             }
-            let b = tri.bounds();
-            if b.min.cmplt(self.bounds.min).any() || b.max.cmpgt(self.bounds.max).any() {
-                return Err(format!("triangle {i} sticks out of the grid bounds"));
-            }
-            if !self.references.contains(&(i as u32)) {
-                return Err(format!("triangle {i} is in no cell"));
-            }
+        }
+        let in_cells = seen.iter().filter(|&&s| s).count();
+        if in_cells != self.inserted {
+            return Err(format!(
+                "{in_cells} triangles are in cells, {} were inserted",
+                self.inserted
+            ));
         }
         Ok(())
     }

@@ -1,9 +1,41 @@
-//! Ray traversal: Amanatides & Woo (1987), "A fast voxel traversal algorithm for ray tracing".
+//! Ray traversal: the 3D-DDA of Amanatides & Woo (1987), "A fast voxel traversal algorithm
+//! for ray tracing", with two levels of empty-space skipping: an occupancy bit per cell
+//! (so empty cells never touch the offset array) and one per macrocell of
+//! `MACRO_CELLS`³ cells, which the walk crosses in a single step when it is empty.
 
 use glam::{IVec3, Vec3};
 
-use super::{Grid, GridHit};
+use super::{Grid, GridHit, MACRO_SHIFT};
 use crate::accel::Ray;
+
+/// Counts the work a traversal does, for the benchmark's statistics. The unit type counts
+/// nothing and compiles away.
+pub trait TraversalStats {
+    /// One cell (or one skipped macrocell) stepped through.
+    fn visit_cell(&mut self) {}
+    /// One ray–triangle test.
+    fn test_triangle(&mut self) {}
+}
+
+impl TraversalStats for () {}
+
+/// Cells visited and triangles tested, summed over rays.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraversalCounts {
+    /// Cells and skipped macrocells stepped through.
+    pub cells: u64,
+    /// Ray–triangle tests.
+    pub tests: u64,
+}
+
+impl TraversalStats for TraversalCounts {
+    fn visit_cell(&mut self) {
+        self.cells += 1;
+    }
+    fn test_triangle(&mut self) {
+        self.tests += 1;
+    }
+}
 
 /// The walk of one ray through the cells it crosses, front to back.
 struct CellWalk {
@@ -11,29 +43,56 @@ struct CellWalk {
     cell: IVec3,
     /// −1, 0 or +1 per axis.
     step: IVec3,
+    /// The ray crosses the plane of cell face `k` on axis `a` at `t = slope[a]·k + offset[a]`:
+    /// face distances come from integer coordinates, so no error accumulates.
+    slope: Vec3,
+    offset: Vec3,
     /// Ray parameter at which the ray leaves the current cell, per axis.
     t_next: Vec3,
     /// Ray parameter at which the ray leaves the grid (or reaches `t_max`).
     t_end: f32,
 }
 
+impl CellWalk {
+    /// Parameter of the current cell's far face on `axis` (∞ if the ray is parallel to it).
+    #[inline]
+    fn face_t(&self, axis: usize, face: i32) -> f32 {
+        if self.step[axis] == 0 {
+            f32::INFINITY
+        } else {
+            self.slope[axis] * face as f32 + self.offset[axis]
+        }
+    }
+
+    #[inline]
+    fn far_face(&self, axis: usize) -> i32 {
+        self.cell[axis] + i32::from(self.step[axis] > 0)
+    }
+
+    #[inline]
+    fn refresh(&mut self, axis: usize) {
+        self.t_next[axis] = self.face_t(axis, self.far_face(axis));
+    }
+}
+
 impl Grid {
     /// The closest hit along `ray`, if any.
     pub fn intersect(&self, ray: &Ray) -> Option<GridHit> {
-        let mut walk = self.start_walk(ray)?;
+        self.intersect_counting(ray, &mut ())
+    }
+
+    /// [`Grid::intersect`], reporting its work to `stats`.
+    pub fn intersect_counting(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> Option<GridHit> {
         let mut best: Option<GridHit> = None;
-        loop {
-            let (t_exit, last) = self.cell_exit(&walk);
-            // A hit beyond this cell may be beaten by one in a later cell, so only hits
-            // inside the cell count; the last cell takes everything up to the grid's end.
-            let limit = if last {
-                walk.t_end
-            } else {
-                t_exit.min(walk.t_end)
-            };
-            let mut t_best = best.map_or(ray.t_max, |h| h.t);
-            for &index in self.cell(walk.cell.as_uvec3()) {
-                if let Some(hit) = self.triangles[index as usize].intersect(ray, t_best)
+        let mut t_best = ray.t_max;
+        self.walk(ray, stats, |grid, range, limit, stats| {
+            for k in range {
+                stats.test_triangle();
+                if let Some(hit) = grid.cell_triangles[k].intersect(ray, t_best)
                     && hit.t <= limit
                 {
                     t_best = hit.t;
@@ -41,41 +100,129 @@ impl Grid {
                         t: hit.t,
                         u: hit.u,
                         v: hit.v,
-                        triangle: index,
+                        triangle: grid.cell_triangle_ids[k],
                     });
                 }
             }
-            if best.is_some() || last || t_exit >= walk.t_end {
-                return best;
-            }
-            self.advance(&mut walk, ray);
-        }
+            // Hits in later cells lie beyond this cell's exit, so a hit here is the closest.
+            best.is_some()
+        });
+        best
     }
 
     /// True when anything blocks `ray` within (`t_min`, `t_max`): for shadow rays.
     pub fn occluded(&self, ray: &Ray) -> bool {
+        self.occluded_counting(ray, &mut ())
+    }
+
+    /// [`Grid::occluded`], reporting its work to `stats`.
+    pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        let mut blocked = false;
+        self.walk(ray, stats, |grid, range, _limit, stats| {
+            blocked = grid.cell_triangles[range].iter().any(|tri| {
+                stats.test_triangle();
+                tri.intersect(ray, ray.t_max).is_some()
+            });
+            blocked
+        });
+        blocked
+    }
+
+    /// Walks the non-empty cells along `ray` in order, calling `visit` with where each cell's
+    /// triangles lie in `cell_triangles` and the largest hit parameter that belongs to the
+    /// cell, until `visit` returns true or the ray leaves the grid.
+    fn walk<S: TraversalStats>(
+        &self,
+        ray: &Ray,
+        stats: &mut S,
+        mut visit: impl FnMut(&Grid, std::ops::Range<usize>, f32, &mut S) -> bool,
+    ) {
         let Some(mut walk) = self.start_walk(ray) else {
-            return false;
+            return;
         };
+        let res = self.resolution.as_ivec3();
         loop {
-            if self.cell(walk.cell.as_uvec3()).iter().any(|&i| {
-                self.triangles[i as usize]
-                    .intersect(ray, ray.t_max)
-                    .is_some()
-            }) {
-                return true;
+            stats.visit_cell();
+            if !self.macro_occupied(walk.cell) {
+                if !self.skip_macrocell(&mut walk, ray) {
+                    return;
+                }
+                continue;
             }
-            let (t_exit, last) = self.cell_exit(&walk);
-            if last || t_exit >= walk.t_end {
-                return false;
+            let axis = exit_axis(walk.t_next);
+            let t_exit = walk.t_next[axis];
+            let next = walk.cell[axis] + walk.step[axis];
+            let last =
+                walk.step[axis] == 0 || next < 0 || next >= res[axis] || t_exit >= walk.t_end;
+            if let Some(range) = self.cell_range(self.cell_index(walk.cell.as_uvec3())) {
+                // Only hits inside the cell count; the last cell takes all up to the grid's end.
+                let limit = if last { walk.t_end } else { t_exit };
+                if visit(self, range, limit, stats) {
+                    return;
+                }
             }
-            self.advance(&mut walk, ray);
+            if last {
+                return;
+            }
+            walk.cell[axis] = next;
+            walk.refresh(axis);
         }
+    }
+
+    /// Moves the walk past the empty macrocell holding its current cell, to the first cell of
+    /// the next macrocell along the ray. False when the ray leaves the grid first.
+    fn skip_macrocell(&self, walk: &mut CellWalk, ray: &Ray) -> bool {
+        let res = self.resolution.as_ivec3();
+        let macro_lo = (walk.cell >> MACRO_SHIFT) << MACRO_SHIFT;
+        let macro_hi = (macro_lo + IVec3::splat((1 << MACRO_SHIFT) - 1)).min(res - 1);
+        let mut axis = 0;
+        let mut t_exit = f32::INFINITY;
+        for a in 0..3 {
+            let face = if walk.step[a] > 0 {
+                macro_hi[a] + 1
+            } else {
+                macro_lo[a]
+            };
+            let t = walk.face_t(a, face);
+            if t < t_exit {
+                t_exit = t;
+                axis = a;
+            }
+        }
+        if t_exit >= walk.t_end {
+            return false;
+        }
+        let next = if walk.step[axis] > 0 {
+            macro_hi[axis] + 1
+        } else {
+            macro_lo[axis] - 1
+        };
+        if next < 0 || next >= res[axis] {
+            return false;
+        }
+        // The other axes: the cell under the exit point, kept within the macrocell and never
+        // behind the current cell, so rounding cannot move the walk backwards or sideways.
+        let p = ray.at(t_exit);
+        for a in 0..3 {
+            if a == axis {
+                walk.cell[a] = next;
+            } else if walk.step[a] != 0 {
+                let c = ((p[a] - self.bounds.min[a]) * self.inv_cell_size[a]).floor() as i32;
+                walk.cell[a] = if walk.step[a] > 0 {
+                    c.clamp(walk.cell[a], macro_hi[a])
+                } else {
+                    c.clamp(macro_lo[a], walk.cell[a])
+                };
+            }
+            walk.refresh(a);
+        }
+        true
     }
 
     /// Clips the ray to the grid and finds the first cell; `None` when it misses the grid.
     fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
-        if self.references.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
+        if self.cell_triangles.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite())
+        {
             return None;
         }
         let inv = ray.direction.recip();
@@ -99,43 +246,15 @@ impl Grid {
         let mut walk = CellWalk {
             cell,
             step,
+            slope: self.cell_size * inv,
+            offset: t0,
             t_next: Vec3::INFINITY,
             t_end,
         };
         for axis in 0..3 {
-            walk.t_next[axis] = self.boundary_t(&walk, ray, axis);
+            walk.refresh(axis);
         }
         Some(walk)
-    }
-
-    /// Ray parameter where the ray crosses the current cell's far face along `axis`,
-    /// computed from integer coordinates so that error does not accumulate.
-    #[inline]
-    fn boundary_t(&self, walk: &CellWalk, ray: &Ray, axis: usize) -> f32 {
-        let step = walk.step[axis];
-        if step == 0 {
-            return f32::INFINITY;
-        }
-        let face = walk.cell[axis] + i32::from(step > 0);
-        let plane = self.bounds.min[axis] + face as f32 * self.cell_size[axis];
-        (plane - ray.origin[axis]) / ray.direction[axis]
-    }
-
-    /// Where the ray leaves the current cell, and whether the next cell is outside the grid.
-    #[inline]
-    fn cell_exit(&self, walk: &CellWalk) -> (f32, bool) {
-        let axis = exit_axis(walk.t_next);
-        let next = walk.cell[axis] + walk.step[axis];
-        let last = walk.step[axis] == 0 || next < 0 || next >= self.resolution[axis] as i32;
-        (walk.t_next[axis], last)
-    }
-
-    /// Steps into the next cell.
-    #[inline]
-    fn advance(&self, walk: &mut CellWalk, ray: &Ray) {
-        let axis = exit_axis(walk.t_next);
-        walk.cell[axis] += walk.step[axis];
-        walk.t_next[axis] = self.boundary_t(walk, ray, axis);
     }
 }
 
