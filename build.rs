@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 
 fn main() {
-    let dir = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo")).join(".embree4");
+    let dir =
+        PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo")).join(".embree4");
     println!("cargo:rerun-if-changed={}", dir.display());
     if dir.join("libembree4.so").exists() {
         println!("cargo:rustc-link-search=native={}", dir.display());

@@ -12,7 +12,11 @@ use super::Mesh;
 /// Bytes Embree holds, from its memory-monitor callback.
 static EMBREE_BYTES: AtomicIsize = AtomicIsize::new(0);
 
-unsafe extern "C" fn count_memory(_user: *mut std::os::raw::c_void, bytes: isize, _post: bool) -> bool {
+unsafe extern "C" fn count_memory(
+    _user: *mut std::os::raw::c_void,
+    bytes: isize,
+    _post: bool,
+) -> bool {
     EMBREE_BYTES.fetch_add(bytes, Ordering::Relaxed);
     true
 }
@@ -41,27 +45,45 @@ impl Embree {
             let before = EMBREE_BYTES.load(Ordering::Relaxed);
             let scene = rtcNewScene(device);
             let geometry = rtcNewGeometry(device, RTCGeometryType::TRIANGLE);
-            let vertices = rtcSetNewGeometryBuffer(geometry, RTCBufferType::VERTEX, 0, RTCFormat::FLOAT3, 12, mesh.positions.len())
-                as *mut f32;
+            let vertices = rtcSetNewGeometryBuffer(
+                geometry,
+                RTCBufferType::VERTEX,
+                0,
+                RTCFormat::FLOAT3,
+                12,
+                mesh.positions.len(),
+            ) as *mut f32;
             for (i, p) in mesh.positions.iter().enumerate() {
                 *vertices.add(3 * i) = p.x;
                 *vertices.add(3 * i + 1) = p.y;
                 *vertices.add(3 * i + 2) = p.z;
             }
-            let indices = rtcSetNewGeometryBuffer(geometry, RTCBufferType::INDEX, 0, RTCFormat::UINT3, 12, mesh.indices.len())
-                as *mut u32;
-            for (i, t) in mesh.indices.iter().enumerate() {
-                for k in 0..3 {
-                    *indices.add(3 * i + k) = t[k];
-                }
+            let indices = rtcSetNewGeometryBuffer(
+                geometry,
+                RTCBufferType::INDEX,
+                0,
+                RTCFormat::UINT3,
+                12,
+                mesh.indices.len(),
+            ) as *mut u32;
+            for (i, &index) in mesh.indices.iter().flatten().enumerate() {
+                *indices.add(i) = index;
             }
             rtcCommitGeometry(geometry);
             rtcAttachGeometry(scene, geometry);
             rtcReleaseGeometry(geometry);
             rtcCommitScene(scene);
-            assert_eq!(rtcGetDeviceError(device), RTCError::NONE, "Embree build failed");
+            assert_eq!(
+                rtcGetDeviceError(device),
+                RTCError::NONE,
+                "Embree build failed"
+            );
             let bytes = (EMBREE_BYTES.load(Ordering::Relaxed) - before).max(0) as usize;
-            Embree { device, scene, bytes }
+            Embree {
+                device,
+                scene,
+                bytes,
+            }
         }
     }
 
@@ -86,7 +108,16 @@ impl Embree {
     pub fn intersect(&self, ray: &Ray) -> Option<(f32, u32)> {
         let mut rayhit = RTCRayHit {
             ray: Self::rtc_ray(ray),
-            hit: RTCHit { Ng_x: 0.0, Ng_y: 0.0, Ng_z: 0.0, u: 0.0, v: 0.0, primID: u32::MAX, geomID: u32::MAX, instID: [u32::MAX] },
+            hit: RTCHit {
+                Ng_x: 0.0,
+                Ng_y: 0.0,
+                Ng_z: 0.0,
+                u: 0.0,
+                v: 0.0,
+                primID: u32::MAX,
+                geomID: u32::MAX,
+                instID: [u32::MAX],
+            },
         };
         // SAFETY: the scene is committed and `rayhit` is a valid, exclusively borrowed struct.
         unsafe { rtcIntersect1(self.scene, &mut rayhit, null_mut()) };

@@ -15,13 +15,23 @@ use obvhs::BvhBuildParams;
 use obvhs::cwbvh::CwBvh;
 
 /// The dragon models `tools/fetch-dragon.sh` unpacks, finest first.
-pub const DRAGON_MODELS: [&str; 4] =
-    ["dragon_vrip.ply.gz", "dragon_vrip_res2.ply.gz", "dragon_vrip_res3.ply.gz", "dragon_vrip_res4.ply.gz"];
+pub const DRAGON_MODELS: [&str; 4] = [
+    "dragon_vrip.ply.gz",
+    "dragon_vrip_res2.ply.gz",
+    "dragon_vrip_res3.ply.gz",
+    "dragon_vrip_res4.ply.gz",
+];
 
 /// Path of a dragon model; panics with the fix when the data has not been fetched.
 pub fn dragon_path(model: &str) -> PathBuf {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/dragon").join(model);
-    assert!(path.is_file(), "{} is missing: run tools/setup-dev.sh (or tools/test.sh)", path.display());
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/dragon")
+        .join(model);
+    assert!(
+        path.is_file(),
+        "{} is missing: run tools/setup-dev.sh (or tools/test.sh)",
+        path.display()
+    );
     path
 }
 
@@ -34,7 +44,10 @@ pub struct Mesh {
 impl Mesh {
     pub fn triangles(&self) -> Vec<Triangle> {
         let p = &self.positions;
-        self.indices.iter().map(|&[a, b, c]| Triangle::new(p[a as usize], p[b as usize], p[c as usize])).collect()
+        self.indices
+            .iter()
+            .map(|&[a, b, c]| Triangle::new(p[a as usize], p[b as usize], p[c as usize]))
+            .collect()
     }
 }
 
@@ -60,7 +73,11 @@ impl Obvhs {
                 v2: to_a(p[c as usize]),
             })
             .collect();
-        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(&triangles, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            &triangles,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
         Obvhs { bvh, triangles }
     }
 
@@ -73,18 +90,27 @@ impl Obvhs {
         let mut hit = obvhs::ray::RayHit::none();
         let tris = &self.triangles;
         let indices = &self.bvh.primitive_indices;
-        if self.bvh.ray_traverse(Self::ray(ray), &mut hit, |r, id| tris[indices[id] as usize].intersect(r)) {
+        if self.bvh.ray_traverse(Self::ray(ray), &mut hit, |r, id| {
+            tris[indices[id] as usize].intersect(r)
+        }) {
             Some((hit.t, indices[hit.primitive_id as usize]))
         } else {
             None
         }
     }
 
+    /// obvhs's own test of triangle `id` alone: the hit distance, or infinity.
+    pub fn triangle_hit(&self, id: u32, ray: &Ray) -> f32 {
+        self.triangles[id as usize].intersect(&Self::ray(ray))
+    }
+
     /// True when anything is hit within the ray's extent.
     pub fn occluded(&self, ray: &Ray) -> bool {
         let tris = &self.triangles;
         let indices = &self.bvh.primitive_indices;
-        !self.bvh.ray_traverse_miss(Self::ray(ray), |r, id| tris[indices[id] as usize].intersect(r))
+        !self.bvh.ray_traverse_miss(Self::ray(ray), |r, id| {
+            tris[indices[id] as usize].intersect(r)
+        })
     }
 
     /// Bytes of nodes, index list and triangles.

@@ -21,7 +21,8 @@ pub fn outside_rays(bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
     (0..count)
         .map(|_| {
             let origin = center + radius * unit_vector(&mut rng);
-            let target = bounds.min + Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * bounds.extent();
+            let target = bounds.min
+                + Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * bounds.extent();
             Ray::new(origin, (target - origin).normalize())
         })
         .collect()
@@ -56,5 +57,7 @@ pub fn bounce_rays(triangles: &[Triangle], bounds: &Aabb, count: usize, seed: u6
 /// The same rays cut to segments of random length up to `max_length`, as shadow rays are.
 pub fn segments(rays: &[Ray], max_length: f32, seed: u64) -> Vec<Ray> {
     let mut rng = Rng::new(seed, 3);
-    rays.iter().map(|r| r.with_t_max(max_length * rng.uniform().max(1e-3))).collect()
+    rays.iter()
+        .map(|r| r.with_t_max(max_length * rng.uniform().max(1e-3)))
+        .collect()
 }
