@@ -115,8 +115,13 @@ fn main() {
         for parallel in [false, true] {
             let (g, gh) = throughput(rays, parallel, &|r| grid.intersect(r).is_some());
             let (e, eh) = throughput(rays, parallel, &|r| embree.intersect(r).is_some());
-            let (b, _) = throughput(rays, parallel, &|r| bvh.intersect(r).is_some());
-            assert_eq!(gh, eh, "grid and Embree disagree on the number of hits");
+            let (b, bh) = throughput(rays, parallel, &|r| bvh.intersect(r).is_some());
+            if !parallel {
+                // Hit counts may differ by a few edge grazes; tests/accel_cross_check.rs says why.
+                counts_lines.push(format!(
+                    "{name} rays hit: grid {gh}, Embree {eh}, CWBVH {bh}"
+                ));
+            }
             println!(
                 "| {name} | {} | {g:.3} | {e:.3} | {b:.3} | {:.2} | {:.2} |",
                 if parallel { threads } else { 1 },

@@ -164,6 +164,33 @@ impl Grid {
     }
 }
 
+/// `len` copies of `value`, in memory the kernel is asked to back with 2 MiB pages before it
+/// is first touched. Rays read the triangle copies at random across tens of megabytes; with
+/// 4 KiB pages nearly every cell visit would also miss the TLB.
+fn huge_page_vec<T: Clone>(len: usize, value: T) -> Vec<T> {
+    let mut v: Vec<T> = Vec::with_capacity(len);
+    #[cfg(target_os = "linux")]
+    {
+        const HUGE: usize = 2 << 20;
+        let start = v.as_mut_ptr() as usize;
+        let end = start + len * std::mem::size_of::<T>();
+        let aligned = start.next_multiple_of(HUGE);
+        if end > aligned + HUGE {
+            // SAFETY: the range lies inside the vector's own allocation; madvise only changes
+            // how the kernel backs it and never invalidates memory. Failure is harmless.
+            unsafe {
+                libc::madvise(
+                    aligned as *mut libc::c_void,
+                    (end - aligned) / HUGE * HUGE,
+                    libc::MADV_HUGEPAGE,
+                )
+            };
+        }
+    }
+    v.resize(len, value);
+    v
+}
+
 /// The box grown by a small fraction of its size, so flat meshes get a volume and no
 /// triangle lies exactly on the boundary.
 fn padded(b: Aabb) -> Aabb {

@@ -87,27 +87,27 @@ impl Grid {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
-        let mut best: Option<GridHit> = None;
-        let mut t_best = ray.t_max;
+        // The nearest hit found so far, wherever it lies; it is the answer once it lies
+        // within the cell being visited, since every later cell lies beyond that cell.
+        let mut nearest: Option<GridHit> = None;
+        let mut t_nearest = ray.t_max;
         self.walk(ray, stats, |grid, range, limit, stats| {
             for k in range {
+                let id = grid.cell_triangle_ids[k];
                 stats.test_triangle();
-                if let Some(hit) = grid.cell_triangles[k].intersect(ray, t_best)
-                    && hit.t <= limit
-                {
-                    t_best = hit.t;
-                    best = Some(GridHit {
+                if let Some(hit) = grid.cell_triangles[k].intersect(ray, t_nearest) {
+                    t_nearest = hit.t;
+                    nearest = Some(GridHit {
                         t: hit.t,
                         u: hit.u,
                         v: hit.v,
-                        triangle: grid.cell_triangle_ids[k],
+                        triangle: id,
                     });
                 }
             }
-            // Hits in later cells lie beyond this cell's exit, so a hit here is the closest.
-            best.is_some()
+            t_nearest <= limit
         });
-        best
+        nearest
     }
 
     /// True when anything blocks `ray` within (`t_min`, `t_max`): for shadow rays.
