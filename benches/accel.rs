@@ -67,7 +67,8 @@ fn main() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(gridtrace::accel::grid::DEFAULT_DENSITY);
-    let (grid, grid_build) = timed(|| Grid::build_with_density(triangles.clone(), density));
+    let (grid, grid_build) =
+        timed(|| Grid::from_mesh_with_density(mesh.positions.clone(), &mesh.indices, density));
     let (embree, embree_build) = timed(|| Embree::build(&mesh));
     let (bvh, bvh_build) = timed(|| Obvhs::build(&mesh));
 

@@ -246,7 +246,7 @@ fn grid_agrees_with_embree_and_obvhs_on_the_dragon() {
     for (i, model) in DRAGON_MODELS.iter().enumerate() {
         let (positions, indices) = ply::read_mesh(&dragon_path(model)).unwrap();
         let mesh = Mesh { positions, indices };
-        let grid = Grid::build(mesh.triangles());
+        let grid = Grid::from_mesh(mesh.positions.clone(), &mesh.indices);
         grid.validate().unwrap();
         // At least 100,000 rays per set on the full dragon; fewer on the decimated ones.
         let count = if i == 0 { 100_000 } else { 40_000 };

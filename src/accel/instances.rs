@@ -8,7 +8,7 @@
 use glam::Affine3A;
 use rayon::prelude::*;
 
-use super::{Grid, Ray, Triangle};
+use super::{Grid, Ray};
 use crate::scene::{Aabb, Scene};
 
 /// A closest hit in the scene.
@@ -44,17 +44,7 @@ impl SceneAccel {
         let grids: Vec<Grid> = scene
             .meshes
             .par_iter()
-            .map(|mesh| {
-                let p = &mesh.positions;
-                Grid::build(
-                    mesh.indices
-                        .iter()
-                        .map(|&[a, b, c]| {
-                            Triangle::new(p[a as usize], p[b as usize], p[c as usize])
-                        })
-                        .collect(),
-                )
-            })
+            .map(|mesh| Grid::from_mesh(mesh.positions.clone(), &mesh.indices))
             .collect();
         let instances = scene
             .instances

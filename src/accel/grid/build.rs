@@ -13,22 +13,49 @@ const MAX_RESOLUTION: u32 = 2048;
 const MAX_CELLS: u64 = 1 << 28;
 
 impl Grid {
-    /// Builds a grid over `triangles` with the default density.
+    /// Builds a grid over a triangle soup with the default density.
     pub fn build(triangles: Vec<Triangle>) -> Grid {
         Grid::build_with_density(triangles, DEFAULT_DENSITY)
     }
 
-    /// Builds a grid with about `density` cells per triangle.
-    ///
-    /// Degenerate triangles (no area, or non-finite corners) go into no cell and so are never
-    /// hit; hits still report indices into `triangles`.
+    /// Builds a grid over a triangle soup with about `density` cells per triangle.
     pub fn build_with_density(triangles: Vec<Triangle>, density: f32) -> Grid {
-        let live: Vec<u32> = (0..triangles.len() as u32)
-            .filter(|&i| !triangles[i as usize].is_degenerate())
+        let vertices: Vec<Vec3> = triangles.iter().flat_map(|t| t.vertices()).collect();
+        let indices: Vec<[u32; 3]> = (0..triangles.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
             .collect();
-        let tight = live
-            .iter()
-            .fold(Aabb::EMPTY, |b, &i| b.union(triangles[i as usize].bounds()));
+        Grid::from_mesh_with_density(vertices, &indices, density)
+    }
+
+    /// Builds a grid over an indexed mesh with the default density.
+    pub fn from_mesh(vertices: Vec<Vec3>, indices: &[[u32; 3]]) -> Grid {
+        Grid::from_mesh_with_density(vertices, indices, DEFAULT_DENSITY)
+    }
+
+    /// Builds a grid over an indexed mesh with about `density` cells per triangle.
+    ///
+    /// Degenerate triangles (no area, non-finite corners, or corners past the vertex array)
+    /// go into no cell and so are never hit; hits report indices into `indices`.
+    pub fn from_mesh_with_density(vertices: Vec<Vec3>, indices: &[[u32; 3]], density: f32) -> Grid {
+        let triangle = |t: &[u32; 3]| {
+            t.iter()
+                .all(|&i| (i as usize) < vertices.len())
+                .then(|| {
+                    Triangle::new(
+                        vertices[t[0] as usize],
+                        vertices[t[1] as usize],
+                        vertices[t[2] as usize],
+                    )
+                })
+                .filter(|tri| !tri.is_degenerate())
+        };
+        let triangles: Vec<Option<Triangle>> = indices.iter().map(triangle).collect();
+        let live: Vec<u32> = (0..indices.len() as u32)
+            .filter(|&i| triangles[i as usize].is_some())
+            .collect();
+        let tight = live.iter().fold(Aabb::EMPTY, |b, &i| {
+            b.union(triangles[i as usize].unwrap().bounds())
+        });
         let (bounds, resolution) = if tight.is_empty() {
             (
                 Aabb {
@@ -50,24 +77,27 @@ impl Grid {
             occupancy: Vec::new(),
             rank: Vec::new(),
             offsets: Vec::new(),
-            cell_triangles: Vec::new(),
+            vertices,
+            cell_corners: Vec::new(),
             cell_triangle_ids: Vec::new(),
             macro_resolution: UVec3::ONE,
             macro_occupancy: Vec::new(),
-            triangle_count: triangles.len(),
+            triangle_count: indices.len(),
             inserted: live.len(),
         };
-        grid.insert(&triangles, &live);
+        grid.insert(&triangles, indices, &live);
         grid
     }
 
     /// Fills the compact storage in two passes over the triangles: count the references of
     /// every cell, then place each triangle after its cell's prefix sum.
-    fn insert(&mut self, triangles: &[Triangle], live: &[u32]) {
+    fn insert(&mut self, triangles: &[Option<Triangle>], indices: &[[u32; 3]], live: &[u32]) {
         let cells = self.cell_count();
         let mut counts = vec![0u32; cells];
         for &t in live {
-            self.for_each_overlapped_cell(&triangles[t as usize], |cell| counts[cell] += 1);
+            self.for_each_overlapped_cell(&triangles[t as usize].unwrap(), |cell| {
+                counts[cell] += 1
+            });
         }
         // Occupancy bits, ranks and macrocell bits from the counts.
         let r = self.resolution;
@@ -108,19 +138,17 @@ impl Grid {
             total += here;
         }
         self.offsets.push(total);
-        let mut cell_triangles =
-            vec![Triangle::new(Vec3::ZERO, Vec3::ZERO, Vec3::ZERO); total as usize];
-        let mut cell_triangle_ids = vec![0; total as usize];
+        let mut cell_corners = vec![[0u32; 3]; total as usize];
+        let mut cell_triangle_ids = vec![0u32; total as usize];
         for &t in live {
-            let tri = triangles[t as usize];
-            self.for_each_overlapped_cell(&tri, |cell| {
+            self.for_each_overlapped_cell(&triangles[t as usize].unwrap(), |cell| {
                 let slot = counts[cell] as usize;
-                cell_triangles[slot] = tri;
+                cell_corners[slot] = indices[t as usize];
                 cell_triangle_ids[slot] = t;
                 counts[cell] += 1;
             });
         }
-        self.cell_triangles = cell_triangles;
+        self.cell_corners = cell_corners;
         self.cell_triangle_ids = cell_triangle_ids;
     }
 
@@ -162,33 +190,6 @@ impl Grid {
         let c = ((p - self.bounds.min) * self.inv_cell_size).floor();
         c.max(Vec3::ZERO).as_uvec3().min(self.resolution - 1)
     }
-}
-
-/// `len` copies of `value`, in memory the kernel is asked to back with 2 MiB pages before it
-/// is first touched. Rays read the triangle copies at random across tens of megabytes; with
-/// 4 KiB pages nearly every cell visit would also miss the TLB.
-fn huge_page_vec<T: Clone>(len: usize, value: T) -> Vec<T> {
-    let mut v: Vec<T> = Vec::with_capacity(len);
-    #[cfg(target_os = "linux")]
-    {
-        const HUGE: usize = 2 << 20;
-        let start = v.as_mut_ptr() as usize;
-        let end = start + len * std::mem::size_of::<T>();
-        let aligned = start.next_multiple_of(HUGE);
-        if end > aligned + HUGE {
-            // SAFETY: the range lies inside the vector's own allocation; madvise only changes
-            // how the kernel backs it and never invalidates memory. Failure is harmless.
-            unsafe {
-                libc::madvise(
-                    aligned as *mut libc::c_void,
-                    (end - aligned) / HUGE * HUGE,
-                    libc::MADV_HUGEPAGE,
-                )
-            };
-        }
-    }
-    v.resize(len, value);
-    v
 }
 
 /// The box grown by a small fraction of its size, so flat meshes get a volume and no

@@ -3,8 +3,9 @@
 //! Triangles go only into the cells they really overlap (triangle–box separating-axis
 //! test). Storage is compact (after Lagae & Dutré 2008): one occupancy bit per cell, a
 //! running count of occupied cells per 64-bit word (so an occupied cell's rank is one
-//! popcount away), offsets for occupied cells only, and the triangles themselves copied in
-//! cell order, so a cell's triangles sit together in memory. A second bit array marks the
+//! popcount away), offsets for occupied cells only, and each cell's triangles as corner
+//! indices into one vertex array, cell after cell, so a cell's triangles sit together in
+//! memory and the vertices (shared, a few megabytes) stay in cache. A second bit array marks the
 //! occupied macrocells of `2^MACRO_SHIFT`³ cells, which lets the walk cross empty space in
 //! large steps. Traversal is the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if
 //! it lies within the current cell.
@@ -43,11 +44,13 @@ pub struct Grid {
     occupancy: Vec<u64>,
     /// Occupied cells before each word of `occupancy`.
     rank: Vec<u32>,
-    /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes `cell_triangles`.
+    /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes `cell_corners`.
     offsets: Vec<u32>,
-    /// The triangles of every occupied cell, cell after cell.
-    cell_triangles: Vec<Triangle>,
-    /// The mesh index of each entry of `cell_triangles`.
+    /// Vertex positions.
+    vertices: Vec<Vec3>,
+    /// The corners of the triangles of every occupied cell, cell after cell.
+    cell_corners: Vec<[u32; 3]>,
+    /// The mesh index of each entry of `cell_corners`.
     cell_triangle_ids: Vec<u32>,
     /// Macrocells per axis.
     macro_resolution: UVec3,
@@ -118,13 +121,14 @@ impl Grid {
             resolution: self.resolution,
             cells,
             triangles: self.inserted,
-            references: self.cell_triangles.len(),
+            references: self.cell_corners.len(),
             empty_fraction: 1.0 - occupied as f64 / cells as f64,
             bytes: std::mem::size_of::<Grid>()
                 + std::mem::size_of_val(self.occupancy.as_slice())
                 + std::mem::size_of_val(self.rank.as_slice())
                 + std::mem::size_of_val(self.offsets.as_slice())
-                + std::mem::size_of_val(self.cell_triangles.as_slice())
+                + std::mem::size_of_val(self.vertices.as_slice())
+                + std::mem::size_of_val(self.cell_corners.as_slice())
                 + std::mem::size_of_val(self.cell_triangle_ids.as_slice())
                 + std::mem::size_of_val(self.macro_occupancy.as_slice()),
         }
@@ -135,7 +139,18 @@ impl Grid {
         (c.x + self.resolution.x * (c.y + self.resolution.y * c.z)) as usize
     }
 
-    /// Where the triangles of cell `index` lie in `cell_triangles`; `None` for empty cells.
+    /// The `k`-th stored triangle.
+    #[inline]
+    fn cell_triangle(&self, k: usize) -> Triangle {
+        let [a, b, c] = self.cell_corners[k];
+        Triangle::new(
+            self.vertices[a as usize],
+            self.vertices[b as usize],
+            self.vertices[c as usize],
+        )
+    }
+
+    /// Where the triangles of cell `index` lie in `cell_corners`; `None` for empty cells.
     #[inline]
     fn cell_range(&self, index: usize) -> Option<Range<usize>> {
         let word = self.occupancy[index >> 6];
@@ -185,10 +200,18 @@ impl Grid {
         if self.offsets.windows(2).any(|w| w[0] >= w[1]) {
             return Err("an occupied cell is empty or offsets decrease".into());
         }
-        if *self.offsets.last().unwrap() as usize != self.cell_triangles.len()
-            || self.cell_triangle_ids.len() != self.cell_triangles.len()
+        if *self.offsets.last().unwrap() as usize != self.cell_corners.len()
+            || self.cell_triangle_ids.len() != self.cell_corners.len()
         {
-            return Err("offsets, triangle copies and ids disagree in length".into());
+            return Err("offsets, corners and ids disagree in length".into());
+        }
+        if self
+            .cell_corners
+            .iter()
+            .flatten()
+            .any(|&i| i as usize >= self.vertices.len())
+        {
+            return Err("a corner index is past the vertex array".into());
         }
         let mut seen = vec![false; self.triangle_count];
         for z in 0..self.resolution.z {
@@ -210,7 +233,7 @@ impl Grid {
                     };
                     for k in range {
                         let id = self.cell_triangle_ids[k] as usize;
-                        let b = self.cell_triangles[k].bounds();
+                        let b = self.cell_triangle(k).bounds();
                         if id >= self.triangle_count {
                             return Err(format!(
                                 "cell {c} refers to triangle {id} of {}",

@@ -95,7 +95,7 @@ impl Grid {
             for k in range {
                 let id = grid.cell_triangle_ids[k];
                 stats.test_triangle();
-                if let Some(hit) = grid.cell_triangles[k].intersect(ray, t_nearest) {
+                if let Some(hit) = grid.cell_triangle(k).intersect(ray, t_nearest) {
                     t_nearest = hit.t;
                     nearest = Some(GridHit {
                         t: hit.t,
@@ -119,9 +119,9 @@ impl Grid {
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         let mut blocked = false;
         self.walk(ray, stats, |grid, range, _limit, stats| {
-            blocked = grid.cell_triangles[range].iter().any(|tri| {
+            blocked = range.into_iter().any(|k| {
                 stats.test_triangle();
-                tri.intersect(ray, ray.t_max).is_some()
+                grid.cell_triangle(k).intersect(ray, ray.t_max).is_some()
             });
             blocked
         });
@@ -129,7 +129,7 @@ impl Grid {
     }
 
     /// Walks the non-empty cells along `ray` in order, calling `visit` with where each cell's
-    /// triangles lie in `cell_triangles` and the largest hit parameter that belongs to the
+    /// triangles lie in `cell_corners` and the largest hit parameter that belongs to the
     /// cell, until `visit` returns true or the ray leaves the grid.
     fn walk<S: TraversalStats>(
         &self,
@@ -221,8 +221,7 @@ impl Grid {
 
     /// Clips the ray to the grid and finds the first cell; `None` when it misses the grid.
     fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
-        if self.cell_triangles.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite())
-        {
+        if self.cell_corners.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
             return None;
         }
         let inv = ray.direction.recip();
