@@ -1,6 +1,7 @@
 //! Grid construction: resolution, then count → prefix sums → fill into compact storage.
 
 use glam::{UVec3, Vec3};
+use rayon::prelude::*;
 
 use super::overlap::triangle_overlaps_box;
 use super::{DEFAULT_DENSITY, Grid, MACRO_SHIFT};
@@ -89,15 +90,27 @@ impl Grid {
         grid
     }
 
-    /// Fills the compact storage in two passes over the triangles: count the references of
-    /// every cell, then place each triangle after its cell's prefix sum.
+    /// Fills the compact storage: the overlap tests run once, in parallel over chunks of
+    /// triangles, giving (cell, triangle) pairs in triangle order; a counting sort by cell
+    /// (count → prefix sum → place) then lays them out. Within a cell, triangles keep mesh
+    /// order whatever the thread count, so ties between equal hits resolve the same way.
     fn insert(&mut self, triangles: &[Option<Triangle>], indices: &[[u32; 3]], live: &[u32]) {
         let cells = self.cell_count();
+        let chunks: Vec<Vec<(u32, u32)>> = live
+            .par_chunks(4096)
+            .map(|chunk| {
+                let mut pairs = Vec::with_capacity(chunk.len() * 3);
+                for &t in chunk {
+                    self.for_each_overlapped_cell(&triangles[t as usize].unwrap(), |cell| {
+                        pairs.push((cell as u32, t))
+                    });
+                }
+                pairs
+            })
+            .collect();
         let mut counts = vec![0u32; cells];
-        for &t in live {
-            self.for_each_overlapped_cell(&triangles[t as usize].unwrap(), |cell| {
-                counts[cell] += 1
-            });
+        for &(cell, _) in chunks.iter().flatten() {
+            counts[cell as usize] += 1;
         }
         // Occupancy bits, ranks and macrocell bits from the counts.
         let r = self.resolution;
@@ -140,13 +153,11 @@ impl Grid {
         self.offsets.push(total);
         let mut cell_corners = vec![[0u32; 3]; total as usize];
         let mut cell_triangle_ids = vec![0u32; total as usize];
-        for &t in live {
-            self.for_each_overlapped_cell(&triangles[t as usize].unwrap(), |cell| {
-                let slot = counts[cell] as usize;
-                cell_corners[slot] = indices[t as usize];
-                cell_triangle_ids[slot] = t;
-                counts[cell] += 1;
-            });
+        for &(cell, t) in chunks.iter().flatten() {
+            let slot = counts[cell as usize] as usize;
+            cell_corners[slot] = indices[t as usize];
+            cell_triangle_ids[slot] = t;
+            counts[cell as usize] += 1;
         }
         self.cell_corners = cell_corners;
         self.cell_triangle_ids = cell_triangle_ids;
