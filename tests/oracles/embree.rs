@@ -9,6 +9,17 @@ use gridtrace::accel::Ray;
 
 use super::Mesh;
 
+/// An `RTCRayHit` with room behind it. The bindings come from Embree 4.2 headers, whose
+/// `RTCHit` ends at `instID`; the 4.4 library (built with instance arrays) also writes
+/// `instPrimID` after it, 4 bytes past the 4.2 struct. Without this padding that write
+/// lands on whatever the stack holds next: it corrupted neighbouring variables here and
+/// is a likely cause of the crashes seen when calling Embree from many threads.
+#[repr(C, align(16))]
+struct PaddedRayHit {
+    rayhit: RTCRayHit,
+    _room: [u32; 8],
+}
+
 /// Bytes Embree holds, from its memory-monitor callback.
 static EMBREE_BYTES: AtomicIsize = AtomicIsize::new(0);
 
@@ -106,21 +117,26 @@ impl Embree {
 
     /// Closest hit (`rtcIntersect1`): (t, triangle index).
     pub fn intersect(&self, ray: &Ray) -> Option<(f32, u32)> {
-        let mut rayhit = RTCRayHit {
-            ray: Self::rtc_ray(ray),
-            hit: RTCHit {
-                Ng_x: 0.0,
-                Ng_y: 0.0,
-                Ng_z: 0.0,
-                u: 0.0,
-                v: 0.0,
-                primID: u32::MAX,
-                geomID: u32::MAX,
-                instID: [u32::MAX],
+        let mut padded = PaddedRayHit {
+            rayhit: RTCRayHit {
+                ray: Self::rtc_ray(ray),
+                hit: RTCHit {
+                    Ng_x: 0.0,
+                    Ng_y: 0.0,
+                    Ng_z: 0.0,
+                    u: 0.0,
+                    v: 0.0,
+                    primID: u32::MAX,
+                    geomID: u32::MAX,
+                    instID: [u32::MAX],
+                },
             },
+            _room: [u32::MAX; 8],
         };
-        // SAFETY: the scene is committed and `rayhit` is a valid, exclusively borrowed struct.
-        unsafe { rtcIntersect1(self.scene, &mut rayhit, null_mut()) };
+        // SAFETY: the scene is committed, and `padded` is exclusively borrowed and large
+        // enough for the 4.4 library's `RTCRayHit` (see `PaddedRayHit`).
+        unsafe { rtcIntersect1(self.scene, &mut padded.rayhit, null_mut()) };
+        let rayhit = &padded.rayhit;
         (rayhit.hit.geomID != u32::MAX).then_some((rayhit.ray.tfar, rayhit.hit.primID))
     }
 
