@@ -9,27 +9,10 @@ use std::f32::consts::FRAC_1_PI;
 use super::sampling::{Frame, cosine_hemisphere};
 use crate::scene::MaterialKind;
 
-/// A scattering model evaluated at one surface point.
+/// A material's scattering model, with the operations the integrator needs: evaluate,
+/// give the pdf of, and sample directions.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Bsdf {
-    /// f = albedo/π.
-    Diffuse {
-        /// Reflectance.
-        albedo: Vec3,
-    },
-    /// A delta lobe about the mirror direction.
-    Mirror {
-        /// Reflectance.
-        reflectance: Vec3,
-    },
-    /// Delta reflection and refraction weighted by the Fresnel equations.
-    Glass {
-        /// Index of refraction of the inside relative to the outside.
-        ior: f32,
-        /// Colour applied at each refraction.
-        tint: Vec3,
-    },
-}
+pub struct Bsdf(pub MaterialKind);
 
 /// A direction drawn from a BSDF.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,32 +32,23 @@ pub struct BsdfSample {
 }
 
 impl Bsdf {
-    /// The model for a material.
-    pub fn from_material(kind: &MaterialKind) -> Bsdf {
-        match *kind {
-            MaterialKind::Diffuse { albedo } => Bsdf::Diffuse { albedo },
-            MaterialKind::Mirror { reflectance } => Bsdf::Mirror { reflectance },
-            MaterialKind::Glass { ior, tint } => Bsdf::Glass { ior, tint },
-        }
-    }
-
     /// True when every lobe is a delta (light sampling is useless there).
     pub fn is_delta(&self) -> bool {
-        !matches!(self, Bsdf::Diffuse { .. })
+        !matches!(self.0, MaterialKind::Diffuse { .. })
     }
 
     /// f(wo, wi) for non-delta lobes; zero for delta lobes and for `wi` below the surface.
     pub fn eval(&self, n: Vec3, _wo: Vec3, wi: Vec3) -> Vec3 {
-        match *self {
-            Bsdf::Diffuse { albedo } if n.dot(wi) > 0.0 => albedo * FRAC_1_PI,
+        match self.0 {
+            MaterialKind::Diffuse { albedo } if n.dot(wi) > 0.0 => albedo * FRAC_1_PI,
             _ => Vec3::ZERO,
         }
     }
 
     /// Solid-angle pdf with which [`Bsdf::sample`] picks `wi`; zero for delta lobes.
     pub fn pdf(&self, n: Vec3, _wo: Vec3, wi: Vec3) -> f32 {
-        match *self {
-            Bsdf::Diffuse { .. } => n.dot(wi).max(0.0) * FRAC_1_PI,
+        match self.0 {
+            MaterialKind::Diffuse { .. } => n.dot(wi).max(0.0) * FRAC_1_PI,
             _ => 0.0,
         }
     }
@@ -89,8 +63,8 @@ impl Bsdf {
         u: Vec2,
         u_lobe: f32,
     ) -> Option<BsdfSample> {
-        match *self {
-            Bsdf::Diffuse { albedo } => {
+        match self.0 {
+            MaterialKind::Diffuse { albedo } => {
                 let wi = Frame::from_normal(n).to_world(cosine_hemisphere(u));
                 let pdf = n.dot(wi) * FRAC_1_PI;
                 (pdf > 0.0).then_some(BsdfSample {
@@ -102,10 +76,10 @@ impl Bsdf {
                     eta_scale: 1.0,
                 })
             }
-            Bsdf::Mirror { reflectance } => {
+            MaterialKind::Mirror { reflectance } => {
                 Some(delta_sample(reflect(wo, n), reflectance, 1.0, false, 1.0))
             }
-            Bsdf::Glass { ior, tint } => {
+            MaterialKind::Glass { ior, tint } => {
                 // η = η_i / η_t for light arriving along wi, which is where wo's side is.
                 let eta = if front { 1.0 / ior } else { ior };
                 let cos_o = n.dot(wo);
@@ -206,10 +180,10 @@ mod tests {
 
     #[test]
     fn glass_lobes_are_picked_with_fresnel_probability() {
-        let glass = Bsdf::Glass {
+        let glass = Bsdf(MaterialKind::Glass {
             ior: 1.5,
             tint: Vec3::ONE,
-        };
+        });
         let wo = Vec3::new(0.0, 0.6, 0.8);
         let f = fresnel_dielectric(0.8, 1.0 / 1.5);
         let refl = glass

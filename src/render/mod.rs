@@ -93,11 +93,7 @@ impl<'a> Renderer<'a> {
             scene,
             accel: SceneAccel::build(scene),
             lights: LightSet::build(scene),
-            bsdfs: scene
-                .materials
-                .iter()
-                .map(|m| Bsdf::from_material(&m.kind))
-                .collect(),
+            bsdfs: scene.materials.iter().map(|m| Bsdf(m.kind)).collect(),
             frames: InstanceFrame::for_scene(scene),
             ray_epsilon: 1e-5 * size.max(1e-3),
         }

@@ -32,6 +32,24 @@ unsafe extern "C" fn count_memory(
     true
 }
 
+/// Gives `geometry` a new Embree-owned buffer holding a copy of `items` (12-byte items).
+///
+/// # Safety
+/// `geometry` must be a live geometry handle; `T` must be 12 bytes matching `format`.
+unsafe fn copy_into_new_buffer<T: Copy>(
+    geometry: RTCGeometry,
+    kind: RTCBufferType,
+    format: RTCFormat,
+    items: &[T],
+) {
+    assert_eq!(std::mem::size_of::<T>(), 12);
+    // SAFETY: Embree allocates room for `items.len()` items of 12 bytes (plus its own padding).
+    unsafe {
+        let buffer = rtcSetNewGeometryBuffer(geometry, kind, 0, format, 12, items.len()) as *mut T;
+        std::ptr::copy_nonoverlapping(items.as_ptr(), buffer, items.len());
+    }
+}
+
 /// A committed Embree scene holding one triangle mesh.
 pub struct Embree {
     device: RTCDevice,
@@ -56,30 +74,19 @@ impl Embree {
             let before = EMBREE_BYTES.load(Ordering::Relaxed);
             let scene = rtcNewScene(device);
             let geometry = rtcNewGeometry(device, RTCGeometryType::TRIANGLE);
-            let vertices = rtcSetNewGeometryBuffer(
+            let vertices: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
+            copy_into_new_buffer(
                 geometry,
                 RTCBufferType::VERTEX,
-                0,
                 RTCFormat::FLOAT3,
-                12,
-                mesh.positions.len(),
-            ) as *mut f32;
-            for (i, p) in mesh.positions.iter().enumerate() {
-                *vertices.add(3 * i) = p.x;
-                *vertices.add(3 * i + 1) = p.y;
-                *vertices.add(3 * i + 2) = p.z;
-            }
-            let indices = rtcSetNewGeometryBuffer(
+                &vertices,
+            );
+            copy_into_new_buffer(
                 geometry,
                 RTCBufferType::INDEX,
-                0,
                 RTCFormat::UINT3,
-                12,
-                mesh.indices.len(),
-            ) as *mut u32;
-            for (i, &index) in mesh.indices.iter().flatten().enumerate() {
-                *indices.add(i) = index;
-            }
+                &mesh.indices,
+            );
             rtcCommitGeometry(geometry);
             rtcAttachGeometry(scene, geometry);
             rtcReleaseGeometry(geometry);
