@@ -104,7 +104,7 @@ fn main() {
     let bounds = Aabb::from_points(mesh.positions.iter().copied());
     let sets = [
         ("outside", outside_rays(&bounds, count, 21)),
-        ("bounce", bounce_rays(&triangles, &bounds, count, 22)),
+        ("bounce", bounce_rays(&triangles, count, 22)),
     ];
     println!();
     println!(

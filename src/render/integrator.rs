@@ -10,7 +10,7 @@ use glam::Vec3;
 use super::Renderer;
 use super::bsdf::Bsdf;
 use super::sampling::{Rng, power_heuristic};
-use super::surface::surface_at;
+use super::surface::{Surface, offset_ray_origin, surface_at};
 use crate::accel::Ray;
 
 /// How direct light is estimated. Only [`Strategy::Mis`] is meant for images; the other two
@@ -25,6 +25,9 @@ pub enum Strategy {
     /// Emission is found only by hitting it with BSDF-sampled rays.
     BsdfOnly,
 }
+
+/// Shadow segments end this fraction short of the light point.
+const SHADOW_EPSILON: f32 = 1e-4;
 
 /// Path depth at which Russian roulette starts.
 const ROULETTE_DEPTH: u32 = 3;
@@ -68,7 +71,7 @@ impl Renderer<'_> {
                 break;
             };
             result.hit |= depth == 0;
-            let s = surface_at(self.scene, &self.frames, &hit, ray.at(hit.t));
+            let s = surface_at(self.scene, &self.frames, &hit);
             let wo = -ray.direction.normalize();
             let cos_o = s.geometric_normal.dot(wo);
             let front = cos_o > 0.0;
@@ -108,8 +111,7 @@ impl Renderer<'_> {
             // Sample a light for the next-event estimate.
             if !bsdf.is_delta() && strategy != Strategy::BsdfOnly {
                 result.rays += 1;
-                result.radiance +=
-                    beta * self.direct_light(&bsdf, s.point, ng, ns, wo, rng, strategy);
+                result.radiance += beta * self.direct_light(&bsdf, &s, ng, ns, wo, rng, strategy);
             }
 
             // Sample the BSDF to extend the path.
@@ -127,7 +129,10 @@ impl Renderer<'_> {
             } else {
                 Arrival::Scattered { pdf: sample.pdf }
             };
-            ray = Ray::new(self.offset(s.point, ng, side), sample.wi);
+            ray = Ray::new(
+                offset_ray_origin(s.point, s.point_error, ng, sample.wi),
+                sample.wi,
+            );
 
             // Possibly terminate the path with Russian roulette. The throughput is judged
             // without the radiance scaling of refractions, which cancels on leaving glass.
@@ -153,7 +158,7 @@ impl Renderer<'_> {
     fn direct_light(
         &self,
         bsdf: &Bsdf,
-        p: Vec3,
+        s: &Surface,
         ng: Vec3,
         ns: Vec3,
         wo: Vec3,
@@ -162,7 +167,7 @@ impl Renderer<'_> {
     ) -> Vec3 {
         let u_light = rng.uniform();
         let u = rng.uniform2();
-        let Some(ls) = self.lights.sample(p, u_light, u) else {
+        let Some(ls) = self.lights.sample(s.point, u_light, u) else {
             return Vec3::ZERO;
         };
         if ls.radiance == Vec3::ZERO || ng.dot(ls.wi) <= 0.0 {
@@ -172,18 +177,15 @@ impl Renderer<'_> {
         if f == Vec3::ZERO {
             return Vec3::ZERO;
         }
-        let origin = self.offset(p, ng, 1.0);
-        let towards = if ls.normal.dot(ls.wi) < 0.0 {
-            ls.normal
-        } else {
-            -ls.normal
-        };
-        let target = ls.point + towards * self.ray_epsilon;
+        // Both ends leave their surface by their own error bounds; the segment stops just
+        // short of the light point (pbrt-v4's 1 − 10⁻⁴), which already lies off the light.
+        let origin = offset_ray_origin(s.point, s.point_error, ng, ls.wi);
+        let target = offset_ray_origin(ls.point, ls.point_error, ls.normal, -ls.wi);
         let shadow = Ray {
             origin,
             direction: target - origin,
             t_min: 0.0,
-            t_max: 1.0,
+            t_max: 1.0 - SHADOW_EPSILON,
         };
         if self.accel.occluded(&shadow) {
             return Vec3::ZERO;
@@ -193,11 +195,5 @@ impl Renderer<'_> {
             _ => 1.0,
         };
         f * ls.radiance * (weight / ls.pdf)
-    }
-
-    /// A ray origin moved off the surface along the geometric normal, to the side
-    /// (`side` > 0: the side `ng` points to) the new ray leaves by.
-    fn offset(&self, p: Vec3, ng: Vec3, side: f32) -> Vec3 {
-        p + ng * self.ray_epsilon.copysign(side)
     }
 }

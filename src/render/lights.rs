@@ -4,14 +4,14 @@
 use glam::{Vec2, Vec3};
 
 use super::sampling::{Distribution1d, uniform_triangle};
+use super::surface::{interpolate_with_error, transform_point_with_error};
 use crate::scene::Scene;
 
 /// One emitting triangle in world space.
 #[derive(Clone, Copy, Debug)]
 struct EmissiveTriangle {
-    v0: Vec3,
-    e1: Vec3,
-    e2: Vec3,
+    /// World-space corners with the rounding-error bound the transform added to each.
+    corners: [(Vec3, Vec3); 3],
     /// Unit geometric normal, on the side the winding calls front.
     normal: Vec3,
     area: f32,
@@ -24,6 +24,8 @@ struct EmissiveTriangle {
 pub struct LightSample {
     /// The point on the light.
     pub point: Vec3,
+    /// Bound on the rounding error of `point`, per axis.
+    pub point_error: Vec3,
     /// The light's unit normal there (front side).
     pub normal: Vec3,
     /// Unit direction from the shading point to the light point.
@@ -59,8 +61,9 @@ impl LightSet {
             first_of_instance.push(Some(triangles.len() as u32));
             let m = inst.world_from_object;
             for &[a, b, c] in &mesh.indices {
-                let [p0, p1, p2] =
-                    [a, b, c].map(|i| m.transform_point3(mesh.positions[i as usize]));
+                let corners =
+                    [a, b, c].map(|i| transform_point_with_error(&m, mesh.positions[i as usize]));
+                let [p0, p1, p2] = corners.map(|c| c.0);
                 let (e1, e2) = (p1 - p0, p2 - p0);
                 let cross = e1.cross(e2);
                 let area = 0.5 * cross.length();
@@ -73,9 +76,7 @@ impl LightSet {
                     1.0
                 };
                 triangles.push(EmissiveTriangle {
-                    v0: p0,
-                    e1,
-                    e2,
+                    corners,
                     normal: if usable {
                         sign * cross / (2.0 * area)
                     } else {
@@ -122,7 +123,7 @@ impl LightSet {
         let (index, pmf) = self.distribution.sample(u_light)?;
         let tri = &self.triangles[index];
         let b = uniform_triangle(u);
-        let point = tri.v0 + b.x * tri.e1 + b.y * tri.e2;
+        let (point, point_error) = interpolate_with_error(tri.corners, [1.0 - b.x - b.y, b.x, b.y]);
         let to_light = point - p;
         let distance_sq = to_light.length_squared();
         let distance = distance_sq.sqrt();
@@ -142,6 +143,7 @@ impl LightSet {
         };
         Some(LightSample {
             point,
+            point_error,
             normal: tri.normal,
             wi,
             distance,

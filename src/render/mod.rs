@@ -16,6 +16,7 @@ pub use camera::RayGenerator;
 pub use film::{Image, PixelAccumulator};
 pub use integrator::{PathResult, Strategy};
 pub use lights::{LightSample, LightSet};
+pub use surface::{gamma, interpolate_with_error, offset_ray_origin, transform_point_with_error};
 
 use std::time::{Duration, Instant};
 
@@ -76,26 +77,17 @@ pub struct Renderer<'a> {
     lights: LightSet,
     bsdfs: Vec<Bsdf>,
     frames: Vec<InstanceFrame>,
-    /// How far new rays start off a surface, from the scene's size.
-    ray_epsilon: f32,
 }
 
 impl<'a> Renderer<'a> {
     /// Builds the acceleration structure and light list for `scene`.
     pub fn new(scene: &'a Scene) -> Renderer<'a> {
-        let bounds = scene.bounds();
-        let size = if bounds.is_empty() {
-            1.0
-        } else {
-            bounds.extent().length() + bounds.min.abs().max(bounds.max.abs()).max_element()
-        };
         Renderer {
             scene,
             accel: SceneAccel::build(scene),
             lights: LightSet::build(scene),
             bsdfs: scene.materials.iter().map(|m| Bsdf(m.kind)).collect(),
             frames: InstanceFrame::for_scene(scene),
-            ray_epsilon: 1e-5 * size.max(1e-3),
         }
     }
 

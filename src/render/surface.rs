@@ -1,6 +1,7 @@
-//! What the renderer needs to know about a hit point: position, normals, material.
+//! What the renderer needs to know about a hit point: position with its rounding-error
+//! bound, normals, material; and how to start new rays from it without hitting it again.
 
-use glam::{Mat3, Vec3};
+use glam::{Affine3A, Mat3, Vec3};
 
 use crate::accel::SceneHit;
 use crate::scene::Scene;
@@ -8,8 +9,10 @@ use crate::scene::Scene;
 /// The local geometry at a ray hit, in world space.
 #[derive(Clone, Copy, Debug)]
 pub struct Surface {
-    /// Hit position.
+    /// Hit position, interpolated from the triangle's world-space corners.
     pub point: Vec3,
+    /// Bound on the absolute rounding error of `point`, per axis.
+    pub point_error: Vec3,
     /// Unit geometric normal on the side the mesh's winding calls front.
     pub geometric_normal: Vec3,
     /// Unit interpolated shading normal (not yet turned to any side).
@@ -18,9 +21,61 @@ pub struct Surface {
     pub material: usize,
 }
 
-/// Per-instance data for turning object-space normals into world space.
+/// γ(n) = nε / (1 − nε), the bound on the relative error of n chained floating-point
+/// operations (Higham 2002; pbrt-v4 §6.8.1), with ε = 2⁻²⁴.
+pub fn gamma(n: i32) -> f32 {
+    let e = n as f32 * (f32::EPSILON * 0.5);
+    e / (1.0 - e)
+}
+
+/// A point transformed by `m`, and a bound on the rounding error that added.
+pub fn transform_point_with_error(m: &Affine3A, p: Vec3) -> (Vec3, Vec3) {
+    let abs = Mat3::from_cols(
+        m.matrix3.x_axis.abs().into(),
+        m.matrix3.y_axis.abs().into(),
+        m.matrix3.z_axis.abs().into(),
+    );
+    let error = gamma(3) * (abs * p.abs() + Vec3::from(m.translation).abs());
+    (m.transform_point3(p), error)
+}
+
+/// Interpolates three corners (with their error bounds) at barycentrics (b0, b1, b2), and
+/// bounds the result's error (pbrt-v4 §6.8.4: γ(7)·Σ|bᵢpᵢ|, plus the corners' own error).
+pub fn interpolate_with_error(corners: [(Vec3, Vec3); 3], b: [f32; 3]) -> (Vec3, Vec3) {
+    let mut point = Vec3::ZERO;
+    let mut error = Vec3::ZERO;
+    for ((p, e), w) in corners.into_iter().zip(b) {
+        point += w * p;
+        error += (w * p).abs() * gamma(7) + w.abs() * e;
+    }
+    (point, error)
+}
+
+/// A ray origin moved off a surface just far enough that the rounding error of `p` cannot
+/// put it on the wrong side: along the normal by the error bound projected on it, towards
+/// the side `w` leaves by, then rounded away from the surface (pbrt-v4 §6.8.6). Because the
+/// bound scales with the coordinates, this works at any scene scale, unlike a fixed epsilon.
+pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
+    let d = n.abs().dot(p_error);
+    let mut offset = d * n;
+    if w.dot(n) < 0.0 {
+        offset = -offset;
+    }
+    let mut po = p + offset;
+    for axis in 0..3 {
+        if offset[axis] > 0.0 {
+            po[axis] = po[axis].next_up();
+        } else if offset[axis] < 0.0 {
+            po[axis] = po[axis].next_down();
+        }
+    }
+    po
+}
+
+/// Per-instance data for turning object-space geometry into world space.
 #[derive(Clone, Copy, Debug)]
 pub struct InstanceFrame {
+    world_from_object: Affine3A,
     /// Inverse transpose of the linear part: normals transform by it.
     normal_matrix: Mat3,
 }
@@ -32,6 +87,7 @@ impl InstanceFrame {
             .instances
             .iter()
             .map(|inst| InstanceFrame {
+                world_from_object: inst.world_from_object,
                 normal_matrix: Mat3::from(inst.world_from_object.matrix3)
                     .inverse()
                     .transpose(),
@@ -40,8 +96,8 @@ impl InstanceFrame {
     }
 }
 
-/// The surface at `hit` of a ray with world-space point `point`.
-pub fn surface_at(scene: &Scene, frames: &[InstanceFrame], hit: &SceneHit, point: Vec3) -> Surface {
+/// The surface at `hit`.
+pub fn surface_at(scene: &Scene, frames: &[InstanceFrame], hit: &SceneHit) -> Surface {
     let inst = &scene.instances[hit.instance as usize];
     let frame = &frames[hit.instance as usize];
     let mesh = &scene.meshes[inst.mesh];
@@ -51,12 +107,15 @@ pub fn surface_at(scene: &Scene, frames: &[InstanceFrame], hit: &SceneHit, point
     // front even under mirroring transforms.
     let geometric = (frame.normal_matrix * (p[1] - p[0]).cross(p[2] - p[0])).normalize_or_zero();
     let w = 1.0 - hit.u - hit.v;
+    let corners = p.map(|p| transform_point_with_error(&frame.world_from_object, p));
+    let (point, point_error) = interpolate_with_error(corners, [w, hit.u, hit.v]);
     let interpolated = w * mesh.normals[a] + hit.u * mesh.normals[b] + hit.v * mesh.normals[c];
     let shading = (frame.normal_matrix * interpolated)
         .try_normalize()
         .unwrap_or(geometric);
     Surface {
         point,
+        point_error,
         geometric_normal: geometric,
         shading_normal: shading,
         material: mesh.material,

@@ -3,6 +3,7 @@
 use glam::Vec3;
 use gridtrace::accel::{Ray, Triangle};
 use gridtrace::render::sampling::{Frame, Rng, cosine_hemisphere, uniform_triangle};
+use gridtrace::render::{interpolate_with_error, offset_ray_origin};
 use gridtrace::scene::Aabb;
 
 fn unit_vector(rng: &mut Rng) -> Vec3 {
@@ -28,28 +29,23 @@ pub fn outside_rays(bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
         .collect()
 }
 
-/// How far bounce rays start off the surface: the renderer's own rule (1e-5 of the scene's
-/// size), so the oracles see the rays the renderer really traces.
-pub fn surface_offset(bounds: &Aabb) -> f32 {
-    1e-5 * (bounds.extent().length() + bounds.min.abs().max(bounds.max.abs()).max_element())
-}
-
 /// 'Bounce' rays: from uniform random points of random triangles, in cosine-distributed
-/// directions about the geometric normal, on either side at random, starting just off the
-/// surface on that side, as the renderer's secondary rays do.
-pub fn bounce_rays(triangles: &[Triangle], bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
+/// directions about the geometric normal, on either side at random, starting off the
+/// surface by the point's rounding-error bound, exactly as the renderer's secondary rays do.
+pub fn bounce_rays(triangles: &[Triangle], count: usize, seed: u64) -> Vec<Ray> {
     let mut rng = Rng::new(seed, 2);
     let live: Vec<&Triangle> = triangles.iter().filter(|t| !t.is_degenerate()).collect();
-    let offset = surface_offset(bounds);
     (0..count)
         .map(|_| {
             let tri = live[((rng.uniform() * live.len() as f32) as usize).min(live.len() - 1)];
             let b = uniform_triangle(rng.uniform2());
-            let p = tri.v0 + b.x * tri.e1 + b.y * tri.e2;
+            let corners = tri.vertices().map(|v| (v, Vec3::ZERO));
+            let (p, error) = interpolate_with_error(corners, [1.0 - b.x - b.y, b.x, b.y]);
             let side = if rng.uniform() < 0.5 { 1.0 } else { -1.0 };
             let n = side * tri.e1.cross(tri.e2).normalize();
             let direction = Frame::from_normal(n).to_world(cosine_hemisphere(rng.uniform2()));
-            Ray::new(p + offset * n, direction.normalize())
+            let direction = direction.normalize();
+            Ray::new(offset_ray_origin(p, error, n, direction), direction)
         })
         .collect()
 }
