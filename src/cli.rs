@@ -1,6 +1,7 @@
 //! The command-line driver: parse arguments, load, render, write. Errors exit with code 2.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
@@ -64,11 +65,35 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Runs the command line and returns the process exit code.
+/// Set by the first Ctrl-C: finish the current pass, write the image, exit with 130.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// How a run ended, when it did not fail.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// All samples were taken and the image written.
+    Completed,
+    /// Ctrl-C stopped the render early; the image written holds fewer samples.
+    Interrupted,
+}
+
+/// Runs the command line and returns the process exit code: 0, 2 on errors, 130 (as for
+/// SIGINT) when Ctrl-C stopped the render and the partial image was written.
 pub fn main() -> i32 {
     let args = Args::parse();
-    match run(&args) {
-        Ok(()) => 0,
+    // A second Ctrl-C quits at once, without writing.
+    let _ = ctrlc::set_handler(|| {
+        if STOP.swap(true, Ordering::SeqCst) {
+            eprintln!("\ninterrupted again: quitting without writing the image");
+            std::process::exit(130);
+        }
+        eprintln!(
+            "\ninterrupted: finishing the current pass, then writing the image (Ctrl-C again quits)"
+        );
+    });
+    match run(&args, &STOP) {
+        Ok(Outcome::Completed) => 0,
+        Ok(Outcome::Interrupted) => 130,
         Err(e) => {
             eprintln!("error: {e:#}");
             2
@@ -76,8 +101,9 @@ pub fn main() -> i32 {
     }
 }
 
-/// Loads, renders and writes as `args` says.
-pub fn run(args: &Args) -> Result<()> {
+/// Loads, renders and writes as `args` says; rendering stops early, and the image so far is
+/// written, once `stop` is set.
+pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let output = args
         .output
         .clone()
@@ -141,9 +167,17 @@ pub fn run(args: &Args) -> Result<()> {
             load_start.elapsed().as_secs_f64()
         );
     }
-    let bar = progress_bar(height, args.quiet);
-    let (image, stats) = pool.install(|| renderer.render(&camera, &settings, &|| bar.inc(1)));
+    let bar = progress_bar(height as u64 * settings.spp as u64, args.quiet);
+    let (image, stats) =
+        pool.install(|| renderer.render_until(&camera, &settings, &|| bar.inc(1), stop));
     bar.finish_and_clear();
+    let interrupted = stats.spp < settings.spp;
+    if interrupted {
+        eprintln!(
+            "stopped after {} of {} samples per pixel; writing the image so far",
+            stats.spp, settings.spp
+        );
+    }
     if stats.nonfinite > 0 {
         eprintln!(
             "warning: {} sample(s) were NaN or infinite and were dropped",
@@ -155,13 +189,17 @@ pub fn run(args: &Args) -> Result<()> {
         let seconds = stats.elapsed.as_secs_f64().max(1e-9);
         eprintln!(
             "rendered {width}x{height} at {} spp in {seconds:.2} s: {:.2} M samples/s, {:.2} M rays/s; wrote {}",
-            settings.spp,
+            stats.spp,
             stats.samples as f64 / seconds / 1e6,
             stats.rays as f64 / seconds / 1e6,
             output.display()
         );
     }
-    Ok(())
+    Ok(if interrupted {
+        Outcome::Interrupted
+    } else {
+        Outcome::Completed
+    })
 }
 
 /// `SCENE_STEM.exr` in the current folder.
@@ -237,14 +275,15 @@ pub fn image_size(width: Option<u32>, height: Option<u32>, aspect: Option<f32>) 
     }
 }
 
-fn progress_bar(rows: u32, quiet: bool) -> ProgressBar {
+/// A bar over `steps` (rows × passes).
+fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
     if quiet {
         return ProgressBar::hidden();
     }
-    let bar = ProgressBar::with_draw_target(Some(rows as u64), ProgressDrawTarget::stderr());
+    let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
     bar.set_style(
         ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] [{bar:40}] {percent:>3}% rows, ETA {eta}",
+            "{spinner} [{elapsed_precise}] [{bar:40}] {percent:>3}%, ETA {eta}",
         )
         .expect("static template")
         .progress_chars("=> "),

@@ -88,6 +88,16 @@ fn renders_the_bundled_scene_to_png_and_exr() {
     .unwrap();
     let size = exr.layer_data.size;
     assert_eq!((size.width(), size.height()), (40, 30));
+    let spp = exr
+        .layer_data
+        .attributes
+        .other
+        .get(&exr::meta::attribute::Text::from("spp"));
+    assert_eq!(
+        spp,
+        Some(&exr::meta::attribute::AttributeValue::I32(2)),
+        "the header records the samples per pixel"
+    );
     let pixels = &exr.layer_data.channel_data.pixels;
     assert!(pixels.iter().all(|p| p.iter().all(|c| c.is_finite())));
     assert!(
@@ -224,4 +234,49 @@ fn help_explains_every_option() {
     ] {
         assert!(help.contains(option), "--help lacks {option}:\n{help}");
     }
+}
+
+#[test]
+fn ctrl_c_stops_after_the_current_pass_and_writes_the_image_so_far() {
+    let dir = tempfile::tempdir().unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_gridtrace"))
+        .args([
+            &asset("cornell_box.glb"),
+            "-o",
+            "partial.exr",
+            "--width",
+            "64",
+            "--spp",
+            "1000000",
+            "-q",
+        ])
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Let a few passes finish, then interrupt as a terminal's Ctrl-C would.
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("stopped after") && err.contains("of 1000000 samples per pixel"),
+        "{err}"
+    );
+    let meta = exr::meta::MetaData::read_from_file(dir.path().join("partial.exr"), false).unwrap();
+    let spp = match meta.headers[0]
+        .own_attributes
+        .other
+        .get(&exr::meta::attribute::Text::from("spp"))
+    {
+        Some(exr::meta::attribute::AttributeValue::I32(n)) => *n,
+        other => panic!("no spp attribute: {other:?}"),
+    };
+    assert!((1..1_000_000).contains(&spp), "spp {spp}");
+    assert!(err.contains(&format!("stopped after {spp} of")), "{err}");
 }

@@ -444,25 +444,52 @@ fn scaled(mut scene: Scene, s: f32) -> Scene {
 fn images_do_not_depend_on_the_scene_scale() {
     for s in [1e-3f32, 1e4] {
         let mut b = SceneBuilder::new();
-        let wall = b.add_material(Material::diffuse("wall", Vec3::splat(0.6)).with_emission(Vec3::splat(0.5)));
+        let wall = b.add_material(
+            Material::diffuse("wall", Vec3::splat(0.6)).with_emission(Vec3::splat(0.5)),
+        );
         add_box_inside(&mut b, wall);
         let furnace = scaled(b.build(), s);
         let renderer = Renderer::new(&furnace);
-        let settings = RenderSettings { width: 24, height: 24, spp: 64, max_depth: 1000, seed: 5, strategy: Strategy::Mis };
+        let settings = RenderSettings {
+            width: 24,
+            height: 24,
+            spp: 64,
+            max_depth: 1000,
+            seed: 5,
+            strategy: Strategy::Mis,
+        };
         let (image, _) = renderer.render(&camera_at(0.0, 60.0), &settings, &|| {});
         let values: Vec<f64> = image.pixels.iter().map(|p| p.x as f64).collect();
         let n = values.len() as f64;
         let mean = values.iter().sum::<f64>() / n;
-        let stderr = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
-        assert!((mean - 1.25).abs() < 4.0 * stderr, "furnace at scale {s}: {mean:.4} ± {stderr:.4}, expected 1.25");
+        let stderr =
+            (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        assert!(
+            (mean - 1.25).abs() < 4.0 * stderr,
+            "furnace at scale {s}: {mean:.4} ± {stderr:.4}, expected 1.25"
+        );
     }
-    let reference = estimate(&test_room(true), &camera_at(3.4, 40.0), Strategy::Mis, SEEDS, 32, 16);
+    let reference = estimate(
+        &test_room(true),
+        &camera_at(3.4, 40.0),
+        Strategy::Mis,
+        SEEDS,
+        32,
+        16,
+    );
     for s in [1e-3f32, 1e4] {
         let camera = Camera {
             world_from_camera: Affine3A::from_translation(Vec3::new(0.0, 0.0, 3.4 * s)),
             ..camera_at(0.0, 40.0)
         };
-        let at_scale = estimate(&scaled(test_room(true), s), &camera, Strategy::Mis, SEEDS, 32, 16);
+        let at_scale = estimate(
+            &scaled(test_room(true), s),
+            &camera,
+            Strategy::Mis,
+            SEEDS,
+            32,
+            16,
+        );
         assert_agree(&format!("room at scale {s} vs 1"), &reference, &at_scale);
     }
 }

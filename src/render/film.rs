@@ -13,6 +13,8 @@ pub struct Image {
     pub pixels: Vec<Vec3>,
     /// Fraction of camera rays per pixel that hit geometry.
     pub alpha: Vec<f32>,
+    /// Samples per pixel the image holds.
+    pub spp: u32,
 }
 
 impl Image {
@@ -24,6 +26,7 @@ impl Image {
             height,
             pixels: vec![Vec3::ZERO; n],
             alpha: vec![0.0; n],
+            spp: 0,
         }
     }
 

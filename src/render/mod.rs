@@ -18,6 +18,7 @@ pub use integrator::{PathResult, Strategy};
 pub use lights::{LightSample, LightSet};
 pub use surface::{gamma, interpolate_with_error, offset_ray_origin, transform_point_with_error};
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
@@ -68,6 +69,8 @@ pub struct RenderStats {
     pub nonfinite: u64,
     /// Wall-clock time of the pixel loop.
     pub elapsed: Duration,
+    /// Samples per pixel taken: the requested count, or fewer if the render was stopped.
+    pub spp: u32,
 }
 
 /// A scene prepared for rendering.
@@ -101,54 +104,68 @@ impl<'a> Renderer<'a> {
         &self.accel
     }
 
-    /// Renders an image. `on_row` is called once per finished row, from worker threads.
-    ///
-    /// Each pixel draws from its own random stream, seeded by the pixel index and the seed,
-    /// and sums its samples in a fixed order, so the image is bit-identical for any number
-    /// of threads.
+    /// Renders an image. `on_row` is called once per row per pass, from worker threads.
     pub fn render(
         &self,
         camera: &Camera,
         settings: &RenderSettings,
         on_row: &(dyn Fn() + Sync),
     ) -> (Image, RenderStats) {
+        self.render_until(camera, settings, on_row, &AtomicBool::new(false))
+    }
+
+    /// Renders in passes of one sample per pixel, stopping early after the pass during which
+    /// `stop` becomes true; the image then holds the samples of the finished passes
+    /// ([`Image::spp`]).
+    ///
+    /// Each pixel draws from its own random stream, seeded by the pixel index and the seed,
+    /// which carries over from pass to pass, and sums its samples in a fixed order, so the
+    /// image is bit-identical for any number of threads and does not depend on the passes.
+    pub fn render_until(
+        &self,
+        camera: &Camera,
+        settings: &RenderSettings,
+        on_row: &(dyn Fn() + Sync),
+        stop: &AtomicBool,
+    ) -> (Image, RenderStats) {
         let start = Instant::now();
         let generator = RayGenerator::new(camera, settings.width, settings.height);
         let width = settings.width as usize;
         let spp = settings.spp.max(1);
         let seed = mix64(settings.seed);
-        let mut image = Image::new(settings.width, settings.height);
-        let (rays, nonfinite) = image
-            .pixels
-            .par_chunks_mut(width)
-            .zip(image.alpha.par_chunks_mut(width))
-            .enumerate()
-            .map(|(y, (radiance_row, alpha_row))| {
-                let (mut rays, mut nonfinite) = (0u64, 0u64);
-                for x in 0..width {
-                    let mut rng = Rng::new(seed, (y * width + x) as u64);
-                    let mut acc = PixelAccumulator::default();
-                    for _ in 0..spp {
+        let mut pixels: Vec<(Rng, PixelAccumulator)> = (0..width * settings.height as usize)
+            .map(|i| (Rng::new(seed, i as u64), PixelAccumulator::default()))
+            .collect();
+        let mut stats = RenderStats::default();
+        while stats.spp < spp {
+            stats.rays += pixels
+                .par_chunks_mut(width)
+                .enumerate()
+                .map(|(y, row)| {
+                    let mut rays = 0u64;
+                    for (x, (rng, acc)) in row.iter_mut().enumerate() {
                         let jitter = rng.uniform2();
                         let ray = generator.generate(x as f32 + jitter.x, y as f32 + jitter.y);
-                        let path =
-                            self.trace_path(ray, &mut rng, settings.max_depth, settings.strategy);
+                        let path = self.trace_path(ray, rng, settings.max_depth, settings.strategy);
                         rays += path.rays;
                         acc.add(path.radiance, path.hit);
                     }
-                    nonfinite += acc.nonfinite as u64;
-                    (radiance_row[x], alpha_row[x]) = acc.resolve(spp);
-                }
-                on_row();
-                (rays, nonfinite)
-            })
-            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-        let mut stats = RenderStats {
-            samples: spp as u64 * width as u64 * settings.height as u64,
-            rays,
-            nonfinite,
-            elapsed: Default::default(),
-        };
+                    on_row();
+                    rays
+                })
+                .sum::<u64>();
+            stats.spp += 1;
+            if stop.load(Ordering::Relaxed) {
+                break;
+            }
+        }
+        let mut image = Image::new(settings.width, settings.height);
+        image.spp = stats.spp;
+        for (i, (_, acc)) in pixels.iter().enumerate() {
+            (image.pixels[i], image.alpha[i]) = acc.resolve(stats.spp);
+            stats.nonfinite += acc.nonfinite as u64;
+        }
+        stats.samples = stats.spp as u64 * pixels.len() as u64;
         stats.elapsed = start.elapsed();
         (image, stats)
     }
