@@ -63,6 +63,15 @@ pub struct Args {
     /// No progress bar and no summary; warnings and errors are still printed.
     #[arg(short, long)]
     pub quiet: bool,
+
+    /// Refuse scenes with more triangles than this (after instancing), before building
+    /// anything; raise it to render bigger scenes.
+    #[arg(long, value_name = "N", default_value_t = 200_000_000)]
+    pub max_triangles: u64,
+
+    /// Refuse images with more pixels than this; raise it to render bigger images.
+    #[arg(long, value_name = "N", default_value_t = 1 << 28)]
+    pub max_pixels: u64,
 }
 
 /// Set by the first Ctrl-C: finish the current pass, write the image, exit with 130.
@@ -121,6 +130,14 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         eprintln!("warning: {warning}");
     }
     let scene = loaded.scene;
+    let triangles = scene.instanced_triangle_count() as u64;
+    if triangles > args.max_triangles {
+        bail!(
+            "{}: {triangles} triangles after instancing, more than --max-triangles {}",
+            args.scene.display(),
+            args.max_triangles
+        );
+    }
     if scene.instanced_triangle_count() == 0 {
         eprintln!(
             "warning: {}: the scene has no triangles; the image will be empty",
@@ -135,6 +152,13 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
 
     let camera = choose_camera(&scene, args.camera.as_deref(), args.width, args.height)?;
     let (width, height) = image_size(args.width, args.height, camera.aspect_ratio());
+    if width as u64 * height as u64 > args.max_pixels {
+        bail!(
+            "{width}x{height} is {} pixels, more than --max-pixels {}",
+            width as u64 * height as u64,
+            args.max_pixels
+        );
+    }
     if let (Some(w), Some(h), Some(aspect)) = (args.width, args.height, camera.aspect_ratio())
         && ((w as f32 / h as f32) / aspect - 1.0).abs() > 0.01
     {
@@ -254,9 +278,6 @@ pub fn choose_camera(
                     (Some(w), Some(h)) => w as f32 / h as f32,
                     _ => 1.0,
                 };
-                if scene.bounds().is_empty() {
-                    bail!("the scene has no geometry and no camera: nothing to render");
-                }
                 Camera::framing(&scene.bounds(), aspect)
             }
         }),

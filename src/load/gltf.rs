@@ -40,6 +40,7 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
         path: path.to_path_buf(),
         message,
     };
+    check_glb_header(&bytes, path).map_err(gltf_error)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| gltf_error(e.to_string()))?;
     let mut warnings = Vec::new();
@@ -60,11 +61,38 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
         let m = loader.convert_material(&material);
         loader.builder.add_material(m);
     }
+    loader.warn_about_missing_images(&document, base);
     loader.load_scene(&document)?;
     Ok(Loaded {
         scene: loader.builder.build(),
         warnings: loader.warnings,
     })
+}
+
+/// The GLB container's 12-byte header (glTF 2.0 §4.4.2), checked before parsing so a
+/// wrong or truncated file gets a precise message.
+fn check_glb_header(bytes: &[u8], path: &Path) -> Result<(), String> {
+    let is_glb = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if !is_glb && !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    if bytes.len() < 12 || !bytes.starts_with(b"glTF") {
+        return Err("not a GLB file (it does not start with the bytes 'glTF')".into());
+    }
+    let word = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    if word(4) != 2 {
+        return Err(format!("GLB version {} is not supported (only 2)", word(4)));
+    }
+    let declared = word(8) as usize;
+    if declared > bytes.len() {
+        return Err(format!(
+            "truncated GLB: the header says {declared} bytes, the file has {}",
+            bytes.len()
+        ));
+    }
+    Ok(())
 }
 
 fn check_extensions(
@@ -169,6 +197,27 @@ impl GltfLoader {
             kind,
             emission,
             double_sided: material.double_sided(),
+        }
+    }
+
+    /// Textures are not applied yet, but a missing image file is worth knowing about.
+    fn warn_about_missing_images(&mut self, document: &gltf::Document, base: &Path) {
+        for image in document.images() {
+            if let gltf::image::Source::Uri { uri, .. } = image.source()
+                && !uri.starts_with("data:")
+            {
+                // glTF URIs percent-encode reserved characters (RFC 3986).
+                let decoded =
+                    urlencoding::decode(uri).map_or_else(|_| uri.to_string(), |d| d.into_owned());
+                let file = base.join(decoded);
+                if !file.is_file() {
+                    self.warn(format!(
+                        "image {} not found: {}",
+                        image.index(),
+                        file.display()
+                    ));
+                }
+            }
         }
     }
 
@@ -367,6 +416,13 @@ impl GltfLoader {
         };
         let element = accessor.size();
         let stride = view.stride().unwrap_or(element);
+        if stride < element {
+            return Err(self.invalid(format!(
+                "{name}: buffer view {} has byte stride {stride}, smaller than accessor {}'s {element}-byte elements (they would overlap)",
+                view.index(),
+                accessor.index()
+            )));
+        }
         let needed = match accessor.count() {
             0 => 0,
             n => accessor.offset() + stride * (n - 1) + element,

@@ -8,6 +8,7 @@ pub use error::LoadError;
 
 use std::path::Path;
 
+use crate::accel::Triangle;
 use crate::scene::Scene;
 
 /// A loaded scene and the warnings met on the way (things skipped or approximated).
@@ -19,16 +20,52 @@ pub struct Loaded {
     pub warnings: Vec<String>,
 }
 
-/// Loads a scene, choosing the loader by file extension.
+/// Loads a scene, choosing the loader by file extension, and warns about triangles that
+/// will never be hit (no area, or non-finite corners).
 pub fn load_scene(path: &Path) -> Result<Loaded, LoadError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("gltf" | "glb") => gltf::load(path),
-        _ => Err(LoadError::UnknownFormat {
+    let mut loaded = load_by_format(path)?;
+    for mesh in &loaded.scene.meshes {
+        let (mut non_finite, mut zero_area) = (0usize, 0usize);
+        for &[a, b, c] in &mesh.indices {
+            let [p0, p1, p2] = [a, b, c].map(|i| mesh.positions[i as usize]);
+            if !(p0.is_finite() && p1.is_finite() && p2.is_finite()) {
+                non_finite += 1;
+            } else if Triangle::new(p0, p1, p2).is_degenerate() {
+                zero_area += 1;
+            }
+        }
+        let reasons: Vec<String> = [
+            (non_finite, "NaN or infinite corners"),
+            (zero_area, "no area"),
+        ]
+        .iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, why)| format!("{n} triangle(s) with {why}"))
+        .collect();
+        if !reasons.is_empty() {
+            loaded.warnings.push(format!(
+                "{}: {}: skipping {} (they can never be hit)",
+                path.display(),
+                mesh.name,
+                reasons.join(" and ")
+            ));
+        }
+    }
+    Ok(loaded)
+}
+
+fn load_by_format(path: &Path) -> Result<Loaded, LoadError> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if name.ends_with(".gltf") || name.ends_with(".glb") {
+        gltf::load(path)
+    } else if name.ends_with(".ply") || name.ends_with(".ply.gz") {
+        ply::load(path)
+    } else {
+        Err(LoadError::UnknownFormat {
             path: path.to_path_buf(),
-        }),
+        })
     }
 }

@@ -95,9 +95,15 @@ pub fn read_mesh(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
         path: path.to_path_buf(),
         source,
     };
+    // The PLY parser's messages span several lines; the first says what is wrong.
     let invalid = |what: String| LoadError::Invalid {
         path: path.to_path_buf(),
-        what,
+        what: what
+            .lines()
+            .next()
+            .unwrap_or_default()
+            .trim_end()
+            .to_string(),
     };
     let mut file = BufReader::new(std::fs::File::open(path).map_err(io)?);
     let mut magic = [0u8; 2];
