@@ -36,13 +36,19 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
         path: path.to_path_buf(),
         source,
     })?;
+    load_bytes(&bytes, path)
+}
+
+/// Loads glTF or GLB content already in memory; `path` names it in messages and locates
+/// external buffers and images.
+pub fn load_bytes(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
     let gltf_error = |message: String| LoadError::Gltf {
         path: path.to_path_buf(),
         message,
     };
-    check_glb_header(&bytes, path).map_err(gltf_error)?;
+    check_glb_header(bytes, path).map_err(gltf_error)?;
     let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| gltf_error(e.to_string()))?;
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(e.to_string()))?;
     let mut warnings = Vec::new();
     check_extensions(path, &document, &mut warnings)?;
     validate(&document).map_err(gltf_error)?;
@@ -126,6 +132,21 @@ fn check_extensions(
 /// The glTF schema checks (index ranges, required fields), reported with their JSON paths.
 fn validate(document: &gltf::Document) -> Result<(), String> {
     let root = document.as_json();
+    // gltf-json's own check of POSITION's min/max indexes the accessor list before the
+    // index itself is checked, and panics on an index past it (found by fuzzing).
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, accessor) in &primitive.attributes {
+                if accessor.value() >= root.accessors.len() {
+                    return Err(format!(
+                        "meshes[{m}].primitives[{p}].attributes[{semantic:?}]: accessor {} does not exist ({} accessors)",
+                        accessor.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         errors.push(format!("{}: {error}", path()))

@@ -95,6 +95,20 @@ pub fn read_mesh(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
         path: path.to_path_buf(),
         source,
     };
+    let mut file = BufReader::new(std::fs::File::open(path).map_err(io)?);
+    let mut magic = [0u8; 2];
+    let gzip = file.get_mut().read(&mut magic).map_err(io)? == 2 && magic == [0x1f, 0x8b];
+    let file = BufReader::new(std::fs::File::open(path).map_err(io)?);
+    let source: Box<dyn Read> = if gzip {
+        Box::new(flate2::read::MultiGzDecoder::new(file))
+    } else {
+        Box::new(file)
+    };
+    parse_mesh(source, path)
+}
+
+/// Parses PLY content from `source`; `path` names it in messages.
+pub fn parse_mesh(source: impl Read, path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
     // The PLY parser's messages span several lines; the first says what is wrong.
     let invalid = |what: String| LoadError::Invalid {
         path: path.to_path_buf(),
@@ -104,15 +118,6 @@ pub fn read_mesh(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
             .unwrap_or_default()
             .trim_end()
             .to_string(),
-    };
-    let mut file = BufReader::new(std::fs::File::open(path).map_err(io)?);
-    let mut magic = [0u8; 2];
-    let gzip = file.get_mut().read(&mut magic).map_err(io)? == 2 && magic == [0x1f, 0x8b];
-    let file = BufReader::new(std::fs::File::open(path).map_err(io)?);
-    let source: Box<dyn Read> = if gzip {
-        Box::new(flate2::read::MultiGzDecoder::new(file))
-    } else {
-        Box::new(file)
     };
     let mut reader = ply_rs_bw::parser::Reader::new(BufReader::new(source));
 

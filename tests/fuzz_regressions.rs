@@ -1,0 +1,43 @@
+//! Inputs the fuzzers (`fuzz/`, run with `cargo fuzz`) found crashing, kept so they stay
+//! fixed: each file under `tests/fuzz_crashes/<target>/` goes through the same code as its
+//! fuzz target and must come back as an error or a result, never a panic.
+
+use std::path::Path;
+
+use gridtrace::load::{gltf, ply};
+
+fn inputs(target: &str) -> Vec<(String, Vec<u8>)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fuzz_crashes")
+        .join(target);
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .map(|d| d.flatten().map(|e| e.path()).collect())
+        .unwrap_or_default();
+    files.sort();
+    files
+        .into_iter()
+        .map(|p| (p.display().to_string(), std::fs::read(&p).unwrap()))
+        .collect()
+}
+
+#[test]
+fn gltf_crashers_are_errors() {
+    let cases = inputs("gltf");
+    assert!(!cases.is_empty(), "the gltf crasher corpus is missing");
+    for (name, bytes) in cases {
+        let result = gltf::load_bytes(&bytes, Path::new("fuzz.glb"));
+        assert!(result.is_err(), "{name}: expected a clear error");
+        let message = result.unwrap_err().to_string();
+        assert!(
+            message.starts_with("fuzz.glb: ") && !message.contains('\n'),
+            "{name}: {message}"
+        );
+    }
+}
+
+#[test]
+fn ply_crashers_do_not_panic() {
+    for (_, bytes) in inputs("ply") {
+        let _ = ply::parse_mesh(bytes.as_slice(), Path::new("fuzz.ply"));
+    }
+}
