@@ -36,8 +36,15 @@ fn gltf_crashers_are_errors() {
 }
 
 #[test]
-fn ply_crashers_do_not_panic() {
-    for (_, bytes) in inputs("ply") {
-        let _ = ply::parse_mesh(bytes.as_slice(), Path::new("fuzz.ply"));
+fn ply_crashers_are_errors() {
+    let cases = inputs("ply");
+    assert!(!cases.is_empty(), "the ply crasher corpus is missing");
+    for (name, bytes) in cases {
+        let result = ply::parse_mesh(bytes.as_slice(), Path::new("fuzz.ply"), bytes.len() as u64);
+        let message = result.expect_err(&name).to_string();
+        assert!(
+            message.starts_with("fuzz.ply: ") && !message.contains('\n'),
+            "{name}: {message}"
+        );
     }
 }

@@ -4,5 +4,5 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = gridtrace::load::ply::parse_mesh(data, std::path::Path::new("fuzz.ply"));
+    let _ = gridtrace::load::ply::parse_mesh(data, std::path::Path::new("fuzz.ply"), data.len() as u64);
 });

@@ -369,6 +369,21 @@ impl GltfLoader {
         }
         if let Some(accessor) = primitive.indices() {
             self.check_accessor(&accessor, &name)?;
+            // The gltf crate's index reader hits `unreachable!` on other types (found by fuzzing).
+            let integer = matches!(
+                accessor.data_type(),
+                gltf::accessor::DataType::U8
+                    | gltf::accessor::DataType::U16
+                    | gltf::accessor::DataType::U32
+            );
+            if !integer || accessor.dimensions() != gltf::accessor::Dimensions::Scalar {
+                return Err(self.invalid(format!(
+                    "{name}: index accessor {} is {:?} {:?}, not unsigned integer scalars",
+                    accessor.index(),
+                    accessor.dimensions(),
+                    accessor.data_type()
+                )));
+            }
         }
         let buffers = &self.buffers;
         let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));

@@ -95,6 +95,7 @@ pub fn read_mesh(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
         path: path.to_path_buf(),
         source,
     };
+    let file_size = std::fs::metadata(path).map_err(io)?.len();
     let mut file = BufReader::new(std::fs::File::open(path).map_err(io)?);
     let mut magic = [0u8; 2];
     let gzip = file.get_mut().read(&mut magic).map_err(io)? == 2 && magic == [0x1f, 0x8b];
@@ -104,11 +105,22 @@ pub fn read_mesh(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
     } else {
         Box::new(file)
     };
-    parse_mesh(source, path)
+    // Deflate expands at most about 1032:1, which bounds what a gzip file can hold.
+    let budget = if gzip {
+        file_size.saturating_mul(1032)
+    } else {
+        file_size
+    };
+    parse_mesh(source, path, budget)
 }
 
-/// Parses PLY content from `source`; `path` names it in messages.
-pub fn parse_mesh(source: impl Read, path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
+/// Parses PLY content from `source`, which holds at most `budget` bytes; `path` names it in
+/// messages. Element counts the budget cannot hold are refused before anything is read.
+pub fn parse_mesh(
+    source: impl Read,
+    path: &Path,
+    budget: u64,
+) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
     // The PLY parser's messages span several lines; the first says what is wrong.
     let invalid = |what: String| LoadError::Invalid {
         path: path.to_path_buf(),
@@ -126,6 +138,7 @@ pub fn parse_mesh(source: impl Read, path: &Path) -> Result<(Vec<Vec3>, Vec<[u32
     let header = vertex_parser
         .read_header(&mut reader)
         .map_err(|e| invalid(format!("bad PLY header: {e}")))?;
+    check_declared_sizes(&header, budget).map_err(invalid)?;
     let mut positions = Vec::new();
     let mut faces = Vec::new();
     for element in header.elements.values() {
@@ -164,6 +177,46 @@ pub fn parse_mesh(source: impl Read, path: &Path) -> Result<(Vec<Vec3>, Vec<[u32
         }
     }
     Ok((positions, triangles))
+}
+
+/// Refuses headers whose elements cannot fit in `budget` bytes: each element needs at least
+/// its scalar properties and list counts in binary, or a character and a separator per
+/// property in ASCII. A binary element without properties takes no bytes at all, so any
+/// count of it would be created from nothing (found by fuzzing: 777,777,721 of them).
+fn check_declared_sizes(header: &ply_rs_bw::ply::Header, budget: u64) -> Result<(), String> {
+    use ply_rs_bw::ply::{Encoding, PropertyType, ScalarType};
+    let size = |t: &ScalarType| match t {
+        ScalarType::Char | ScalarType::UChar => 1u64,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    };
+    let mut needed = 0u64;
+    for element in header.elements.values() {
+        let properties = element.properties.values();
+        let per_element = match header.encoding {
+            Encoding::Ascii => 2 * element.properties.len() as u64,
+            _ => properties
+                .map(|p| match &p.data_type {
+                    PropertyType::Scalar(t) => size(t),
+                    PropertyType::List(count, _) => size(count),
+                })
+                .sum(),
+        };
+        if per_element == 0 && element.count > 0 && header.encoding != Encoding::Ascii {
+            return Err(format!(
+                "element '{}' declares {} items but no properties",
+                element.name, element.count
+            ));
+        }
+        needed = needed.saturating_add((element.count as u64).saturating_mul(per_element.max(1)));
+    }
+    if needed > budget {
+        return Err(format!(
+            "the header declares at least {needed} bytes of data, but the file can hold at most {budget}"
+        ));
+    }
+    Ok(())
 }
 
 /// Loads a PLY file as a one-mesh scene.
