@@ -5,7 +5,7 @@
 //! exported from Blender hold tens of objects, so the instances are tested in a flat list
 //! after a bounding-box check.
 
-use glam::Affine3A;
+use glam::{Affine3A, Vec3};
 use rayon::prelude::*;
 
 use super::{Grid, Ray};
@@ -52,9 +52,10 @@ impl SceneAccel {
             .map(|inst| PlacedInstance {
                 grid: inst.mesh,
                 object_from_world: inst.world_from_object.inverse(),
-                world_bounds: grids[inst.mesh]
-                    .bounds()
-                    .transformed(&inst.world_from_object),
+                world_bounds: culling_bounds(
+                    &scene.meshes[inst.mesh].bounds(),
+                    &inst.world_from_object,
+                ),
             })
             .collect();
         SceneAccel { grids, instances }
@@ -97,6 +98,22 @@ impl SceneAccel {
     }
 }
 
+/// World bounds for culling rays against an instance: the mesh's own bounds, transformed,
+/// grown by a few ulps of their coordinates to cover rounding. Not the grid's bounds: those
+/// are padded by a fraction of the mesh's size, and a ray leaving a flat mesh (a wall)
+/// starts inside that padding, so it would walk the wall's grid for nothing.
+fn culling_bounds(object: &Aabb, world_from_object: &Affine3A) -> Aabb {
+    let b = object.transformed(world_from_object);
+    if b.is_empty() {
+        return b;
+    }
+    let pad = Vec3::splat(2.0 * f32::EPSILON * b.min.abs().max(b.max.abs()).max_element());
+    Aabb {
+        min: b.min - pad,
+        max: b.max + pad,
+    }
+}
+
 /// The ray in object space. The direction is transformed without normalising, so the
 /// ray parameter `t` means the same point in both spaces.
 fn to_object(ray: &Ray, object_from_world: &Affine3A) -> Ray {
@@ -113,7 +130,9 @@ fn hits_box(b: &Aabb, ray: &Ray, t_max: f32) -> bool {
     let t0 = (b.min - ray.origin) * inv;
     let t1 = (b.max - ray.origin) * inv;
     let near = t0.min(t1);
-    let far = t0.max(t1);
+    // Widen each slab's exit by its rounding error, so a ray through the box is never
+    // culled by rounding (pbrt-v4 §6.8.2: t_far·(1 + 2γ(3))).
+    let far = t0.max(t1) * (1.0 + 2.0 * crate::accel::SLAB_ROUNDING);
     let t_start = ray.t_min.max(near.x).max(near.y).max(near.z);
     let t_end = t_max.min(far.x).min(far.y).min(far.z);
     t_start <= t_end

@@ -10,3 +10,6 @@ pub use grid::{Grid, GridHit, GridStats, TraversalCounts, TraversalStats};
 pub use instances::{SceneAccel, SceneHit};
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};
+
+/// γ(3) = 3ε/(1 − 3ε) with ε = 2⁻²⁴: the relative rounding error of a slab distance.
+pub(crate) const SLAB_ROUNDING: f32 = 3.0 * f32::EPSILON * 0.5 / (1.0 - 3.0 * f32::EPSILON * 0.5);

@@ -229,7 +229,9 @@ impl Grid {
         let t1 = (self.bounds.max - ray.origin) * inv;
         // f32::max/min skip NaN (0·∞ for an origin on a slab of a parallel axis).
         let near = t0.min(t1);
-        let far = t0.max(t1);
+        // Widen each slab's exit by its rounding error, so a ray through the box is never
+        // clipped away by rounding (pbrt-v4 §6.8.2: t_far·(1 + 2γ(3))).
+        let far = t0.max(t1) * (1.0 + 2.0 * crate::accel::SLAB_ROUNDING);
         let t_start = ray.t_min.max(near.x).max(near.y).max(near.z);
         let t_end = ray.t_max.min(far.x).min(far.y).min(far.z);
         // Written so that a NaN bound also counts as a miss.
