@@ -322,36 +322,46 @@ fn light_sampling_bsdf_sampling_and_mis_converge_to_the_same_image() {
     }
 }
 
+/// A closed box whose inward-facing walls all emit `le` and reflect with `albedo`.
+fn furnace(le: f32, albedo: f32) -> Scene {
+    let mut b = SceneBuilder::new();
+    let wall = b.add_material(
+        Material::diffuse("wall", Vec3::splat(albedo)).with_emission(Vec3::splat(le)),
+    );
+    add_box_inside(&mut b, wall);
+    b.build()
+}
+
+/// Renders a furnace from its centre and returns the pixel mean and its standard error.
+/// The furnace is grey, so one channel per pixel: pixels are independent samples.
+fn furnace_mean(scene: &Scene, strategy: Strategy, seed: u64) -> (f64, f64) {
+    let renderer = Renderer::new(scene);
+    let settings = RenderSettings {
+        width: 24,
+        height: 24,
+        spp: 64,
+        max_depth: 1000,
+        seed,
+        strategy,
+    };
+    let (image, stats) = renderer.render(&camera_at(0.0, 60.0), &settings, &|| {});
+    assert_eq!(stats.nonfinite, 0);
+    let values: Vec<f64> = image.pixels.iter().map(|p| p.x as f64).collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let stderr = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    (mean, stderr)
+}
+
 /// Inside a closed box whose walls all emit Le and reflect with albedo a, every ray sees
 /// L = Le + a·L, so L = Le / (1 − a), at every pixel.
 #[test]
 fn white_furnace_matches_its_closed_form() {
     for (le, albedo) in [(0.5f32, 0.6f32), (1.0, 0.9)] {
-        let mut b = SceneBuilder::new();
-        let wall = b.add_material(
-            Material::diffuse("wall", Vec3::splat(albedo)).with_emission(Vec3::splat(le)),
-        );
-        add_box_inside(&mut b, wall);
-        let scene = b.build();
+        let scene = furnace(le, albedo);
         let expected = (le / (1.0 - albedo)) as f64;
         for strategy in [Strategy::Mis, Strategy::LightOnly, Strategy::BsdfOnly] {
-            let renderer = Renderer::new(&scene);
-            let settings = RenderSettings {
-                width: 24,
-                height: 24,
-                spp: 64,
-                max_depth: 1000,
-                seed: 3,
-                strategy,
-            };
-            let (image, stats) = renderer.render(&camera_at(0.0, 60.0), &settings, &|| {});
-            assert_eq!(stats.nonfinite, 0);
-            // The furnace is grey, so one channel per pixel: pixels are independent samples.
-            let values: Vec<f64> = image.pixels.iter().map(|p| p.x as f64).collect();
-            let n = values.len() as f64;
-            let mean = values.iter().sum::<f64>() / n;
-            let stderr =
-                (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+            let (mean, stderr) = furnace_mean(&scene, strategy, 3);
             assert!(
                 (mean - expected).abs() < 4.0 * stderr,
                 "Le={le}, a={albedo}, {strategy:?}: mean {mean:.4} ± {stderr:.4}, expected {expected:.4}"
@@ -443,27 +453,7 @@ fn scaled(mut scene: Scene, s: f32) -> Scene {
 #[test]
 fn images_do_not_depend_on_the_scene_scale() {
     for s in [1e-3f32, 1e4] {
-        let mut b = SceneBuilder::new();
-        let wall = b.add_material(
-            Material::diffuse("wall", Vec3::splat(0.6)).with_emission(Vec3::splat(0.5)),
-        );
-        add_box_inside(&mut b, wall);
-        let furnace = scaled(b.build(), s);
-        let renderer = Renderer::new(&furnace);
-        let settings = RenderSettings {
-            width: 24,
-            height: 24,
-            spp: 64,
-            max_depth: 1000,
-            seed: 5,
-            strategy: Strategy::Mis,
-        };
-        let (image, _) = renderer.render(&camera_at(0.0, 60.0), &settings, &|| {});
-        let values: Vec<f64> = image.pixels.iter().map(|p| p.x as f64).collect();
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let stderr =
-            (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        let (mean, stderr) = furnace_mean(&scaled(furnace(0.5, 0.6), s), Strategy::Mis, 5);
         assert!(
             (mean - 1.25).abs() < 4.0 * stderr,
             "furnace at scale {s}: {mean:.4} ± {stderr:.4}, expected 1.25"
