@@ -88,7 +88,7 @@ pub struct GridStats {
     pub references: usize,
     /// Fraction of cells that hold no triangle.
     pub empty_fraction: f64,
-    /// Bytes held by the structure, triangle copies included.
+    /// Bytes held by the structure, vertices and cell arrays included.
     pub bytes: usize,
 }
 
