@@ -1,115 +1,13 @@
 //! The integrator converges to the right answer: light sampling, BSDF sampling and MIS
 //! agree; a closed furnace matches its closed form; images do not depend on thread count.
 
+mod shapes;
+
 use glam::{Affine3A, Vec3};
 use gridtrace::load::load_scene;
 use gridtrace::render::{Image, RenderSettings, Renderer, Strategy};
-use gridtrace::scene::{Camera, Material, MaterialKind, Projection, Scene, SceneBuilder};
-
-fn add_quad(b: &mut SceneBuilder, corners: [Vec3; 4], material: usize) {
-    let mesh = b.add_mesh(
-        "quad",
-        corners.to_vec(),
-        vec![[0, 1, 2], [0, 2, 3]],
-        material,
-    );
-    b.add_instance(mesh, Affine3A::IDENTITY, "quad");
-}
-
-/// The six faces of the box [-1, 1]³, wound to face inwards.
-fn add_box_inside(b: &mut SceneBuilder, material: usize) {
-    let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
-    for face in [
-        [
-            v(-1., -1., -1.),
-            v(1., -1., -1.),
-            v(1., -1., 1.),
-            v(-1., -1., 1.),
-        ],
-        [
-            v(-1., 1., -1.),
-            v(-1., 1., 1.),
-            v(1., 1., 1.),
-            v(1., 1., -1.),
-        ],
-        [
-            v(-1., -1., -1.),
-            v(-1., -1., 1.),
-            v(-1., 1., 1.),
-            v(-1., 1., -1.),
-        ],
-        [
-            v(1., -1., -1.),
-            v(1., 1., -1.),
-            v(1., 1., 1.),
-            v(1., -1., 1.),
-        ],
-        [
-            v(-1., -1., -1.),
-            v(-1., 1., -1.),
-            v(1., 1., -1.),
-            v(1., -1., -1.),
-        ],
-        [
-            v(-1., -1., 1.),
-            v(1., -1., 1.),
-            v(1., 1., 1.),
-            v(-1., 1., 1.),
-        ],
-    ] {
-        add_quad(b, face, material);
-    }
-}
-
-/// A UV sphere, outward-facing, smooth normals.
-fn add_sphere(b: &mut SceneBuilder, center: Vec3, radius: f32, material: usize) {
-    let (rings, segments) = (16u32, 32u32);
-    let mut positions = Vec::new();
-    for r in 0..=rings {
-        for s in 0..=segments {
-            let theta = std::f32::consts::PI * r as f32 / rings as f32;
-            let phi = std::f32::consts::TAU * s as f32 / segments as f32;
-            positions.push(
-                center
-                    + radius
-                        * Vec3::new(
-                            theta.sin() * phi.cos(),
-                            theta.cos(),
-                            -theta.sin() * phi.sin(),
-                        ),
-            );
-        }
-    }
-    let mut indices = Vec::new();
-    let row = segments + 1;
-    for r in 0..rings {
-        for s in 0..segments {
-            let (a, b2, c, d) = (
-                r * row + s,
-                (r + 1) * row + s,
-                (r + 1) * row + s + 1,
-                r * row + s + 1,
-            );
-            indices.push([a, b2, c]);
-            indices.push([a, c, d]);
-        }
-    }
-    let mesh = b.add_mesh("sphere", positions, indices, material);
-    b.add_instance(mesh, Affine3A::IDENTITY, "sphere");
-}
-
-fn camera_at(z: f32, yfov_degrees: f32) -> Camera {
-    Camera {
-        name: "test".into(),
-        world_from_camera: Affine3A::from_translation(Vec3::new(0.0, 0.0, z)),
-        projection: Projection::Perspective {
-            yfov: yfov_degrees.to_radians(),
-            aspect_ratio: None,
-        },
-        znear: 0.0,
-        source: "test".into(),
-    }
-}
+use gridtrace::scene::{Camera, Material, MaterialKind, Scene, SceneBuilder};
+use shapes::{add_box_inside, add_quad, add_sphere, camera_at};
 
 /// An open-fronted diffuse box with a small ceiling light, a mirror and a glass sphere.
 fn test_room(with_specular: bool) -> Scene {

@@ -1,0 +1,306 @@
+//! Scenes whose radiance has a closed form: irradiance from a rectangular emitter, an ideal
+//! mirror, a glass slab, and a closed enclosure in radiative equilibrium that no object may
+//! disturb. Each is checked for all three direct-light strategies where they differ.
+
+mod shapes;
+
+use glam::{Affine3A, DVec3, Vec3};
+use gridtrace::accel::Ray;
+use gridtrace::render::sampling::Rng;
+use gridtrace::render::{RenderSettings, Renderer, Strategy};
+use gridtrace::scene::{Material, MaterialKind, Scene, SceneBuilder};
+use shapes::{add_box_inside, add_box_outside, add_quad, add_sphere, camera_at};
+
+const STRATEGIES: [Strategy; 3] = [Strategy::Mis, Strategy::LightOnly, Strategy::BsdfOnly];
+
+/// Mean radiance along `ray` over `n` paths and its standard error, per channel.
+fn estimate(scene: &Scene, ray: Ray, strategy: Strategy, n: u32) -> (DVec3, DVec3) {
+    let renderer = Renderer::new(scene);
+    let mut rng = Rng::new(7, 11);
+    let (mut sum, mut sum2) = (DVec3::ZERO, DVec3::ZERO);
+    for _ in 0..n {
+        let l = renderer
+            .trace_path(ray, &mut rng, 64, strategy)
+            .radiance
+            .as_dvec3();
+        sum += l;
+        sum2 += l * l;
+    }
+    let mean = sum / n as f64;
+    let variance = (sum2 / n as f64 - mean * mean).max(DVec3::ZERO) * (n as f64 / (n as f64 - 1.0));
+    (mean, (variance / n as f64).sqrt())
+}
+
+/// Asserts that an estimate matches `expected` within 4 standard errors (plus float rounding)
+/// and that it is precise enough for that to mean something.
+fn assert_matches(what: &str, (mean, stderr): (DVec3, DVec3), expected: DVec3, precision: f64) {
+    for c in 0..3 {
+        let tolerance = 4.0 * stderr[c] + 1e-5 * expected[c];
+        assert!(
+            (mean[c] - expected[c]).abs() <= tolerance,
+            "{what}, channel {c}: {:.6} ± {:.6}, expected {:.6}",
+            mean[c],
+            stderr[c],
+            expected[c]
+        );
+        assert!(
+            stderr[c] <= precision * expected[c],
+            "{what}: standard error {} too large to test {}",
+            stderr[c],
+            expected[c]
+        );
+    }
+}
+
+/// Configuration factor from a differential area to a parallel rectangle of sides `a` × `b`
+/// at distance `h`, with the normal through one corner (Howell, *A Catalog of Radiation Heat
+/// Transfer Configuration Factors*, case B-3).
+fn corner_factor(a: f64, b: f64, h: f64) -> f64 {
+    let (x, y) = (a / h, b / h);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    ((x / sx) * (y / sx).atan() + (y / sy) * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
+}
+
+/// Factor from a point to the rectangle [x0, x1] × [z0, z1] at height `h` above it, by adding
+/// and subtracting corner rectangles with signed sides.
+fn rectangle_factor(x0: f64, x1: f64, z0: f64, z1: f64, h: f64) -> f64 {
+    let signed = |x: f64, z: f64| x.signum() * z.signum() * corner_factor(x.abs(), z.abs(), h);
+    signed(x1, z1) - signed(x0, z1) - signed(x1, z0) + signed(x0, z0)
+}
+
+/// A Lambertian floor of albedo ρ at y = 0 under a downward-facing square emitter of
+/// radiance L at height h: the floor's radiance is ρ/π · E with E = π·L·F, F the
+/// configuration factor to the emitter.
+#[test]
+fn floor_under_a_rectangular_light_matches_the_configuration_factor() {
+    let (albedo, radiance, h, half) = (0.6f32, Vec3::new(3.0, 2.0, 1.0), 1.0f32, 0.4f32);
+    let mut b = SceneBuilder::new();
+    let floor = b.add_material(Material::diffuse("floor", Vec3::splat(albedo)));
+    let light = b.add_material(Material {
+        double_sided: false,
+        ..Material::diffuse("light", Vec3::ZERO).with_emission(radiance)
+    });
+    let v = Vec3::new;
+    add_quad(
+        &mut b,
+        [
+            v(-20., 0., -20.),
+            v(-20., 0., 20.),
+            v(20., 0., 20.),
+            v(20., 0., -20.),
+        ],
+        floor,
+    );
+    add_quad(
+        &mut b,
+        [
+            v(-half, h, -half),
+            v(half, h, -half),
+            v(half, h, half),
+            v(-half, h, half),
+        ],
+        light,
+    );
+    let scene = b.build();
+
+    // Under the centre, under a corner and well outside the light's footprint.
+    for (x, z) in [(0.0f32, 0.0f32), (half, half), (1.3, -0.7)] {
+        let (x0, x1) = ((-half - x) as f64, (half - x) as f64);
+        let (z0, z1) = ((-half - z) as f64, (half - z) as f64);
+        let factor = rectangle_factor(x0, x1, z0, z1, h as f64);
+        let expected = radiance.as_dvec3() * albedo as f64 * factor;
+        // Look at the floor point from the side, below the light's height.
+        let target = v(x, 0.0, z);
+        let origin = target + v(4.0, 0.5, 0.3);
+        let ray = Ray::new(origin, target - origin);
+        for strategy in STRATEGIES {
+            let estimate = estimate(&scene, ray, strategy, 200_000);
+            assert_matches(
+                &format!("floor at ({x}, {z}), {strategy:?}"),
+                estimate,
+                expected,
+                0.02,
+            );
+        }
+    }
+}
+
+/// Unpolarised Fresnel reflectance of a smooth interface from outside (index 1) into index
+/// `eta` at incidence angle θ (Hecht, *Optics*, §4.6.2), written out independently of the
+/// renderer's own.
+fn fresnel(cos_i: f64, eta: f64) -> f64 {
+    let sin_t = (1.0 - cos_i * cos_i).sqrt() / eta;
+    let cos_t = (1.0 - sin_t * sin_t).sqrt();
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (cos_t - eta * cos_i) / (cos_t + eta * cos_i);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// A large emitter of radiance `radiance` in the plane z = `z`, facing +Z, that emits only.
+fn add_backdrop(b: &mut SceneBuilder, z: f32, radiance: Vec3) {
+    let light = b.add_material(Material {
+        double_sided: false,
+        ..Material::diffuse("backdrop", Vec3::ZERO).with_emission(radiance)
+    });
+    let v = |x: f32, y: f32| Vec3::new(x, y, z);
+    add_quad(
+        b,
+        [v(-50., -50.), v(50., -50.), v(50., 50.), v(-50., 50.)],
+        light,
+    );
+}
+
+/// An ideal mirror of reflectance ρ shows a uniform emitter at exactly ρ·L.
+#[test]
+fn mirror_reflects_its_reflectance_times_the_radiance() {
+    let (reflectance, radiance) = (Vec3::new(0.9, 0.5, 0.2), Vec3::new(1.0, 2.0, 3.0));
+    let mut b = SceneBuilder::new();
+    add_backdrop(&mut b, -3.0, radiance);
+    let mirror = b.add_material(Material::new(
+        "mirror",
+        MaterialKind::Mirror { reflectance },
+    ));
+    // A mirror in the plane x = z, facing (1, 0, 1)/√2: rays along −X turn to −Z.
+    let v = Vec3::new;
+    add_quad(
+        &mut b,
+        [
+            v(-1., -1., -1.),
+            v(1., -1., 1.),
+            v(1., 1., 1.),
+            v(-1., 1., -1.),
+        ],
+        mirror,
+    );
+    let scene = b.build();
+    let ray = Ray::new(v(5.0, 0.1, 0.0), v(-1.0, 0.0, 0.0));
+    let expected = (reflectance * radiance).as_dvec3();
+    for strategy in STRATEGIES {
+        let (mean, _) = estimate(&scene, ray, strategy, 16);
+        assert!(
+            (mean - expected).abs().max_element() < 1e-5,
+            "{strategy:?}: {mean} vs {expected}"
+        );
+    }
+}
+
+/// A glass slab of index η and transmission tint t in front of a uniform emitter: each face
+/// reflects F (unpolarised Fresnel) and transmits 1 − F, and light bounces between the faces
+/// any number of times, so the transmitted radiance is L·t²·(1 − F)²·Σ F^2k
+/// = L·t²·(1 − F)/(1 + F). The camera sits outside, so the η² radiance scaling cancels.
+#[test]
+fn glass_slab_transmits_the_fresnel_series() {
+    let (eta, radiance) = (1.5f32, Vec3::new(2.0, 1.0, 0.5));
+    for tint in [Vec3::ONE, Vec3::new(0.9, 0.7, 0.4)] {
+        let mut b = SceneBuilder::new();
+        add_backdrop(&mut b, -5.0, radiance);
+        let glass = b.add_material(Material::new(
+            "glass",
+            MaterialKind::Glass { ior: eta, tint },
+        ));
+        // A 40 × 40 × 0.5 slab: the box [-1, 1]³ wound outwards, squashed in z.
+        add_box_outside(
+            &mut b,
+            glass,
+            Affine3A::from_scale(Vec3::new(20.0, 20.0, 0.25)),
+        );
+        let scene = b.build();
+        for degrees in [0.0f32, 30.0, 60.0] {
+            let theta = degrees.to_radians();
+            let direction = Vec3::new(theta.sin(), 0.0, -theta.cos());
+            let ray = Ray::new(Vec3::new(0.0, 0.0, 2.0) - 2.0 * direction, direction);
+            let f = fresnel(theta.cos() as f64, eta as f64);
+            let expected = (radiance * tint * tint).as_dvec3() * (1.0 - f) / (1.0 + f);
+            for strategy in STRATEGIES {
+                let estimate = estimate(&scene, ray, strategy, 200_000);
+                assert_matches(
+                    &format!("slab at {degrees}°, tint {tint}, {strategy:?}"),
+                    estimate,
+                    expected,
+                    0.005,
+                );
+            }
+        }
+    }
+}
+
+/// Radiative equilibrium: inside a closed box whose walls emit (1 − a)·L* and reflect with
+/// albedo a, radiance is L* everywhere. Any object whose emission is (1 − ρ)·L* for its
+/// reflectance ρ leaves that equilibrium alone, and so does lossless glass, which emits
+/// nothing: every pixel must show L*, whatever it looks at. More would be energy created,
+/// less energy lost (a wrong Fresnel branch, a missing η² or a bad MIS weight shows here).
+#[test]
+fn objects_in_radiative_equilibrium_are_invisible() {
+    let equilibrium = 1.0f32;
+    let emitting = |name: &str, kind: MaterialKind, reflectance: f32| Material {
+        emission: Vec3::splat((1.0 - reflectance) * equilibrium),
+        ..Material::new(name, kind)
+    };
+    let mut b = SceneBuilder::new();
+    let walls = b.add_material(emitting(
+        "walls",
+        MaterialKind::Diffuse {
+            albedo: Vec3::splat(0.5),
+        },
+        0.5,
+    ));
+    let diffuse = b.add_material(emitting(
+        "diffuse",
+        MaterialKind::Diffuse {
+            albedo: Vec3::splat(0.9),
+        },
+        0.9,
+    ));
+    let mirror = b.add_material(emitting(
+        "mirror",
+        MaterialKind::Mirror {
+            reflectance: Vec3::splat(0.8),
+        },
+        0.8,
+    ));
+    let glass = b.add_material(Material::new(
+        "glass",
+        MaterialKind::Glass {
+            ior: 1.5,
+            tint: Vec3::ONE,
+        },
+    ));
+    add_box_inside(&mut b, walls);
+    add_sphere(&mut b, Vec3::new(-0.45, -0.4, -0.4), 0.35, diffuse);
+    add_sphere(&mut b, Vec3::new(0.45, -0.4, -0.4), 0.35, mirror);
+    add_sphere(&mut b, Vec3::new(0.0, 0.4, -0.3), 0.4, glass);
+    let scene = b.build();
+    let renderer = Renderer::new(&scene);
+    for strategy in STRATEGIES {
+        let settings = RenderSettings {
+            width: 32,
+            height: 32,
+            spp: 256,
+            max_depth: 1000,
+            seed: 5,
+            strategy,
+        };
+        let (image, stats) = renderer.render(&camera_at(0.9, 70.0), &settings, &|| {});
+        assert_eq!(stats.nonfinite, 0);
+        // Pixels are independent estimates; compare 8×8 blocks with their spread.
+        for by in 0..4 {
+            for bx in 0..4 {
+                let values: Vec<f64> = (0..64)
+                    .map(|i| image.pixel(bx * 8 + i % 8, by * 8 + i / 8).x as f64)
+                    .collect();
+                let mean = values.iter().sum::<f64>() / 64.0;
+                let stderr =
+                    (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 63.0 / 64.0).sqrt();
+                assert!(
+                    (mean - equilibrium as f64).abs() < 5.0 * stderr.max(1e-6),
+                    "{strategy:?}, block ({bx}, {by}): {mean:.4} ± {stderr:.4}, expected {equilibrium}"
+                );
+            }
+        }
+        let mean = image.mean();
+        assert!(
+            (mean - Vec3::splat(equilibrium)).abs().max_element() < 0.01,
+            "{strategy:?}: image mean {mean}"
+        );
+    }
+}
