@@ -134,22 +134,27 @@ def export(path):
     print(f"wrote {path} ({os.path.getsize(path)} bytes)")
 
 
-def main():
-    os.makedirs(ASSETS, exist_ok=True)
-
-    scene = reset()
+def build_cornell_box(scene):
+    """The classic box: two white blocks turned against each other."""
     white = cornell_shell(scene)
     box("TallBox", white, (0.6, 0.6, 1.2), (-0.33, 0.3, 0.0), 17.0)
     box("ShortBox", white, (0.6, 0.6, 0.6), (0.35, -0.3, 0.0), -17.0)
-    export(os.path.join(ASSETS, "cornell_box.glb"))
 
-    scene = reset()
+
+def build_cornell_spheres(scene):
+    """The box with an ideal mirror sphere and an ideal glass sphere."""
     cornell_shell(scene)
     mirror = principled("Mirror", (0.95, 0.95, 0.95), metallic=1.0, roughness=0.0)
     glass = principled("Glass", (1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5)
     sphere("MirrorSphere", mirror, 0.4, (-0.45, 0.35, 0.4))
     sphere("GlassSphere", glass, 0.4, (0.45, -0.3, 0.4))
-    export(os.path.join(ASSETS, "cornell_spheres.glb"))
+
+
+def main():
+    os.makedirs(ASSETS, exist_ok=True)
+    for name, build in (("cornell_box", build_cornell_box), ("cornell_spheres", build_cornell_spheres)):
+        build(reset())
+        export(os.path.join(ASSETS, f"{name}.glb"))
     return 0
 
 

@@ -1,0 +1,248 @@
+"""Export the reference scenes and render their reference images with Blender Cycles.
+
+Run from the repository root with the PyPI `bpy` package (Blender as a Python module):
+
+    pip install bpy==5.0.1
+    python3 tools/blender/make_references.py [--samples N] [--only NAME]
+
+For every scene this writes the glTF file gridtrace renders (the bundled Cornell scenes stay in
+`assets/`, the others go to `tests/scenes/`) and two Cycles renders with different seeds,
+`tests/references/<name>_a.exr` and `_b.exr`, each with half the samples. Their mean is the
+reference; their difference measures the reference's own noise (tests/reference_images.rs).
+
+Before rendering, every Principled BSDF is replaced by the node that is exactly gridtrace's model
+of it (the README's material table): a Diffuse BSDF (Lambertian), a sharp Glossy BSDF (ideal
+mirror, no Fresnel), a sharp Glass BSDF (ideal dielectric), plus an Emission node for emitters.
+Cycles runs unbiased: box pixel filter one pixel wide, no clamping, no denoising, no adaptive
+sampling, no glossy filter, caustics on, 64 bounces, black world.
+"""
+
+import argparse
+import math
+import os
+import sys
+import time
+
+import bpy
+from mathutils import Vector
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import make_cornell  # noqa: E402  (shares the Cornell scene builders)
+from make_cornell import (  # noqa: E402
+    box, build_cornell_box, build_cornell_spheres, export, principled, quad, reset, sphere,
+)
+
+ROOT = make_cornell.ROOT
+SCENES = os.path.join(ROOT, "tests", "scenes")
+REFERENCES = os.path.join(ROOT, "tests", "references")
+SIZE = 128
+
+
+def add_camera(scene, location, target, fov_deg):
+    data = bpy.data.cameras.new("Camera")
+    data.lens_unit = "FOV"
+    data.angle = math.radians(fov_deg)
+    cam = bpy.data.objects.new("Camera", data)
+    cam.location = location
+    direction = [t - l for t, l in zip(target, location)]
+    cam.rotation_euler = Vector(direction).to_track_quat("-Z", "Y").to_euler()
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+
+
+def build_caustic(scene):
+    """A glass sphere over a diffuse floor under one light: the caustic below the sphere is
+    reached only through two refractions, and the floor beyond the light's cone is lit only by
+    light passing the sphere."""
+    floor = principled("Floor", (0.8, 0.8, 0.8))
+    wall = principled("Wall", (0.35, 0.45, 0.7))
+    glass = principled("Glass", (1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5)
+    light = principled("Light", (0.0, 0.0, 0.0), emission=(1.0, 0.95, 0.9), strength=15.0)
+    quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], floor)
+    quad("Wall", [(-3, 1.5, 0), (3, 1.5, 0), (3, 1.5, 3), (-3, 1.5, 3)], wall)
+    sphere("GlassSphere", glass, 0.5, (0.0, 0.0, 0.65))
+    s = 0.4
+    # Wound so that the emitting front face looks down at the floor.
+    quad("Light", [(-s, -s, 3), (-s, s, 3), (s, s, 3), (s, -s, 3)], light)
+    add_camera(scene, (0.0, -4.0, 2.0), (0.0, 0.0, 0.3), 45.0)
+
+
+def build_coloured_lights(scene):
+    """A closed white room lit by two coloured strip lights on the back wall and one small,
+    bright white light behind the camera, out of view, which dominates the room's power."""
+    white = principled("White", (0.75, 0.75, 0.75))
+    blue_box = principled("BlueBox", (0.2, 0.3, 0.75))
+    red = principled("RedLight", (0.0, 0.0, 0.0), emission=(1.0, 0.2, 0.05), strength=8.0)
+    blue = principled("BlueLight", (0.0, 0.0, 0.0), emission=(0.1, 0.3, 1.0), strength=8.0)
+    small = principled("SmallLight", (0.0, 0.0, 0.0), emission=(1.0, 1.0, 1.0), strength=300.0)
+    # One-sided lights (glTF doubleSided: false): a double-sided light this close to a wall
+    # would light a hidden sliver of the wall behind it, which paths find only by chance.
+    for light in (red, blue, small):
+        light.use_backface_culling = True
+    w, d, h = 2.0, 2.0, 2.5
+    quad("Floor", [(-w, -d, 0), (w, -d, 0), (w, d, 0), (-w, d, 0)], white)
+    quad("Ceiling", [(-w, -d, h), (-w, d, h), (w, d, h), (w, -d, h)], white)
+    quad("BackWall", [(-w, d, 0), (w, d, 0), (w, d, h), (-w, d, h)], white)
+    quad("FrontWall", [(-w, -d, 0), (-w, -d, h), (w, -d, h), (w, -d, 0)], white)
+    quad("LeftWall", [(-w, -d, 0), (-w, d, 0), (-w, d, h), (-w, -d, h)], white)
+    quad("RightWall", [(w, -d, 0), (w, -d, h), (w, d, h), (w, d, 0)], white)
+    y = d - 0.01
+    quad("RedStrip", [(-1.5, y, 1.6), (-0.3, y, 1.6), (-0.3, y, 1.75), (-1.5, y, 1.75)], red)
+    quad("BlueStrip", [(0.3, y, 0.6), (1.5, y, 0.6), (1.5, y, 0.75), (0.3, y, 0.75)], blue)
+    s = 0.05
+    z = h - 0.01
+    quad("SmallLight", [(-s, -1.6 - s, z), (-s, -1.6 + s, z), (s, -1.6 + s, z), (s, -1.6 - s, z)], small)
+    box("Box", blue_box, (0.8, 0.8, 0.8), (-0.6, 0.2, 0.0), 30.0)
+    add_camera(scene, (-1.2, -1.8, 1.4), (0.4, 1.0, 0.7), 60.0)
+
+
+# name -> (builder, directory of the exported .glb, total reference samples)
+SCENE_TABLE = {
+    "cornell_box": (build_cornell_box, os.path.join(ROOT, "assets"), 8192),
+    "cornell_spheres": (build_cornell_spheres, os.path.join(ROOT, "assets"), 8192),
+    "caustic": (build_caustic, SCENES, 8192),
+    "coloured_lights": (build_coloured_lights, SCENES, 4096),
+}
+
+
+def principled_inputs(mat):
+    bsdf = mat.node_tree.nodes.get("Principled BSDF")
+    i = bsdf.inputs
+    return {
+        "colour": tuple(i["Base Color"].default_value)[:3],
+        "metallic": i["Metallic"].default_value,
+        "transmission": i["Transmission Weight"].default_value,
+        "ior": i["IOR"].default_value,
+        "emission": tuple(i["Emission Color"].default_value)[:3],
+        "strength": i["Emission Strength"].default_value,
+    }
+
+
+def use_exact_models(mat):
+    """Rebuilds the material's node tree as gridtrace's model of the Principled inputs."""
+    p = principled_inputs(mat)
+    nodes = mat.node_tree.nodes
+    links = mat.node_tree.links
+    nodes.clear()
+    out = nodes.new("ShaderNodeOutputMaterial")
+    if p["transmission"] >= 0.5:
+        surface = nodes.new("ShaderNodeBsdfGlass")
+        surface.distribution = "SHARP" if "SHARP" in _enum_items(surface, "distribution") else "GGX"
+        surface.inputs["Roughness"].default_value = 0.0
+        surface.inputs["IOR"].default_value = p["ior"]
+    elif p["metallic"] >= 0.5:
+        surface = nodes.new("ShaderNodeBsdfGlossy")
+        surface.distribution = "SHARP" if "SHARP" in _enum_items(surface, "distribution") else "GGX"
+        surface.inputs["Roughness"].default_value = 0.0
+    else:
+        surface = nodes.new("ShaderNodeBsdfDiffuse")
+        surface.inputs["Roughness"].default_value = 0.0
+    surface.inputs["Color"].default_value = (*p["colour"], 1.0)
+    shader = surface.outputs["BSDF"]
+    if p["strength"] > 0.0 and max(p["emission"]) > 0.0:
+        emission = nodes.new("ShaderNodeEmission")
+        emission.inputs["Color"].default_value = (*p["emission"], 1.0)
+        emission.inputs["Strength"].default_value = p["strength"]
+        add = nodes.new("ShaderNodeAddShader")
+        links.new(shader, add.inputs[0])
+        links.new(emission.outputs["Emission"], add.inputs[1])
+        shader = add.outputs["Shader"]
+    if mat.use_backface_culling:
+        # glTF doubleSided: false, which gridtrace renders as a black, non-emitting back face.
+        backfacing = nodes.new("ShaderNodeNewGeometry").outputs["Backfacing"]
+        black = nodes.new("ShaderNodeBsdfDiffuse")
+        black.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        mix = nodes.new("ShaderNodeMixShader")
+        links.new(backfacing, mix.inputs["Fac"])
+        links.new(shader, mix.inputs[1])
+        links.new(black.outputs["BSDF"], mix.inputs[2])
+        shader = mix.outputs["Shader"]
+    links.new(shader, out.inputs["Surface"])
+
+
+def _enum_items(node, prop):
+    return {item.identifier for item in node.bl_rna.properties[prop].enum_items}
+
+
+def configure_cycles(scene, samples, seed):
+    scene.render.engine = "CYCLES"
+    scene.render.resolution_x = SIZE
+    scene.render.resolution_y = SIZE
+    scene.render.resolution_percentage = 100
+    scene.render.film_transparent = False
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.image_settings.exr_codec = "ZIP"
+    scene.render.image_settings.color_mode = "RGB"
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+    c = scene.cycles
+    c.device = "CPU"
+    c.samples = samples
+    c.use_adaptive_sampling = False
+    c.use_denoising = False
+    c.seed = seed
+    c.use_animated_seed = False
+    c.pixel_filter_type = "BOX"
+    c.filter_width = 1.0
+    c.sample_clamp_direct = 0.0
+    c.sample_clamp_indirect = 0.0
+    c.blur_glossy = 0.0
+    c.caustics_reflective = True
+    c.caustics_refractive = True
+    c.max_bounces = 64
+    c.diffuse_bounces = 64
+    c.glossy_bounces = 64
+    c.transmission_bounces = 64
+    c.transparent_max_bounces = 64
+    c.volume_bounces = 0
+    c.min_light_bounces = 0
+    c.min_transparent_bounces = 0
+    scene.render.threads_mode = "AUTO"
+    if scene.world is not None:
+        scene.world = None
+    for obj in scene.objects:
+        if obj.type == "MESH":
+            # Cycles' terminator offset bends shadow rays off smooth-shaded faces; gridtrace
+            # has no such offset.
+            obj.cycles.shadow_terminator_geometry_offset = 0.0
+            obj.cycles.shadow_terminator_offset = 0.0
+
+
+def render(scene, path, samples, seed):
+    configure_cycles(scene, samples, seed)
+    scene.render.filepath = path
+    start = time.time()
+    bpy.ops.render.render(write_still=True)
+    print(f"wrote {path}: {samples} spp, seed {seed}, {time.time() - start:.1f} s", flush=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, help="total Cycles samples per pixel per scene")
+    parser.add_argument("--only", action="append", help="scene name (repeatable)")
+    parser.add_argument("--no-export", action="store_true", help="render without rewriting the .glb")
+    args = parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else None)
+
+    os.makedirs(SCENES, exist_ok=True)
+    os.makedirs(REFERENCES, exist_ok=True)
+    for name, (build, directory, samples) in SCENE_TABLE.items():
+        if args.only and name not in args.only:
+            continue
+        samples = args.samples or samples
+        scene = reset()
+        build(scene)
+        if not args.no_export:
+            export(os.path.join(directory, f"{name}.glb"))
+        for mat in bpy.data.materials:
+            if mat.node_tree and mat.node_tree.nodes.get("Principled BSDF"):
+                use_exact_models(mat)
+        for half, seed in (("a", 1), ("b", 2)):
+            render(scene, os.path.join(REFERENCES, f"{name}_{half}.exr"), samples // 2, seed)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
