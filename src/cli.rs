@@ -8,7 +8,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::load::load_scene;
+use crate::load::{GltfLightUnits, LoadOptions, load_scene_with};
 use crate::output::{check_writable, write_image};
 use crate::render::{RenderSettings, Renderer, Strategy};
 use crate::scene::{Camera, Scene};
@@ -72,6 +72,11 @@ pub struct Args {
     /// Refuse images with more pixels than this; raise it to render bigger images.
     #[arg(long, value_name = "N", default_value_t = 1 << 28)]
     pub max_pixels: u64,
+
+    /// What glTF light intensities mean: the specification's candela and lux (Blender's
+    /// "Standard" export), or Blender's "Unitless" or "Raw" lighting modes.
+    #[arg(long, value_enum, value_name = "UNITS", default_value = "standard")]
+    pub gltf_light_units: GltfLightUnits,
 }
 
 /// Set by the first Ctrl-C: finish the current pass, write the image, exit with 130.
@@ -125,7 +130,10 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let pool = pool.build().context("starting worker threads")?;
 
     let load_start = Instant::now();
-    let loaded = load_scene(&args.scene)?;
+    let options = LoadOptions {
+        gltf_light_units: args.gltf_light_units,
+    };
+    let loaded = load_scene_with(&args.scene, &options)?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
@@ -145,7 +153,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         );
     } else if !scene.has_emitters() {
         eprintln!(
-            "warning: {}: the scene has no emitters (no material with emission); the image will be black",
+            "warning: {}: the scene has no emitters (no emissive material, no light); the image will be black",
             args.scene.display()
         );
     }
@@ -178,11 +186,13 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let renderer = pool.install(|| Renderer::new(&scene));
     if !args.quiet {
         eprintln!(
-            "{}: {} triangles in {} instances, {} emissive; camera {}; prepared in {:.2} s",
+            "{}: {} triangles in {} instances, {} emissive, {} punctual light(s); camera {}; \
+             prepared in {:.2} s",
             args.scene.display(),
             scene.instanced_triangle_count(),
             scene.instances.len(),
             renderer.lights().len(),
+            renderer.lights().punctual_len(),
             if camera.name.is_empty() {
                 &camera.source
             } else {

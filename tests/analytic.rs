@@ -8,7 +8,7 @@ use glam::{Affine3A, DVec3, Vec3};
 use gridtrace::accel::Ray;
 use gridtrace::render::sampling::Rng;
 use gridtrace::render::{RenderSettings, Renderer, Strategy};
-use gridtrace::scene::{Material, MaterialKind, Scene, SceneBuilder};
+use gridtrace::scene::{Light, LightKind, Material, MaterialKind, Scene, SceneBuilder};
 use shapes::{add_box_inside, add_box_outside, add_quad, add_sphere, camera_at};
 
 const STRATEGIES: [Strategy; 3] = [Strategy::Mis, Strategy::LightOnly, Strategy::BsdfOnly];
@@ -122,6 +122,145 @@ fn floor_under_a_rectangular_light_matches_the_configuration_factor() {
                 0.02,
             );
         }
+    }
+}
+
+/// A Lambertian floor at y = 0 lit by punctual lights alone: its radiance is ρ/π · E, with
+/// E = I·cos θ / d² for a point or spot light (times the spot's falloff) and E = E⊥·cos θ for a
+/// directional light. Every path gets the same direct light, so the only noise left is the
+/// choice between lights. (The floor is small because a directional light's power, and so
+/// how often it is picked, grows with the scene's area.)
+#[test]
+fn floor_under_punctual_lights_gets_inverse_square_cosine_irradiance() {
+    let albedo = 0.7f32;
+    let floor_scene = |lights: &[LightKind], area_light: Option<Vec3>| {
+        let mut b = SceneBuilder::new();
+        let floor = b.add_material(Material::diffuse("floor", Vec3::splat(albedo)));
+        let v = Vec3::new;
+        add_quad(
+            &mut b,
+            [
+                v(-4., 0., -4.),
+                v(-4., 0., 4.),
+                v(4., 0., 4.),
+                v(4., 0., -4.),
+            ],
+            floor,
+        );
+        if let Some(radiance) = area_light {
+            let light = b.add_material(Material {
+                double_sided: false,
+                ..Material::diffuse("light", Vec3::ZERO).with_emission(radiance)
+            });
+            // Off to the side, so it shadows none of the punctual lights at the test point.
+            let (h, s, c) = (1.0, 0.4, -1.5);
+            add_quad(
+                &mut b,
+                [
+                    v(c - s, h, -s),
+                    v(c + s, h, -s),
+                    v(c + s, h, s),
+                    v(c - s, h, s),
+                ],
+                light,
+            );
+        }
+        for (i, &kind) in lights.iter().enumerate() {
+            b.add_light(Light {
+                name: format!("light {i}"),
+                kind,
+                source: "test".into(),
+            });
+        }
+        b.build()
+    };
+    let view = |x: f32, z: f32| {
+        let target = Vec3::new(x, 0.0, z);
+        let origin = target + Vec3::new(4.0, 0.5, 0.3);
+        Ray::new(origin, target - origin)
+    };
+    let intensity = Vec3::new(5.0, 3.0, 1.0);
+    let position = Vec3::new(0.3, 2.0, -0.2);
+    let point = LightKind::Point {
+        position,
+        intensity,
+        range: None,
+    };
+    let (inner, outer) = (20f32.to_radians(), 30f32.to_radians());
+    let spot = LightKind::Spot {
+        position,
+        direction: Vec3::NEG_Y,
+        intensity,
+        cos_inner: inner.cos(),
+        cos_outer: outer.cos(),
+        range: None,
+    };
+    let sun_direction = Vec3::new(1.0, -2.0, 0.5).normalize();
+    let irradiance = Vec3::new(2.0, 2.5, 3.0);
+    let sun = LightKind::Directional {
+        direction: sun_direction,
+        irradiance,
+    };
+
+    // E at floor point (x, z) from a light at `position` shining with `i` towards it.
+    let inverse_square = |x: f32, z: f32, falloff: f32| {
+        let to_light = position - Vec3::new(x, 0.0, z);
+        let d = to_light.length();
+        (intensity * falloff * (to_light.y / d) / (d * d)).as_dvec3()
+    };
+    let rho_over_pi = albedo as f64 / std::f64::consts::PI;
+    for strategy in STRATEGIES {
+        let scene = floor_scene(&[point], None);
+        for (x, z) in [(0.3, -0.2), (1.5, 0.7), (-2.0, -1.0)] {
+            let expected = rho_over_pi * inverse_square(x, z, 1.0);
+            let (mean, _) = estimate(&scene, view(x, z), strategy, 64);
+            assert!(
+                (mean / expected - 1.0).abs().max_element() < 1e-4,
+                "point at ({x}, {z}), {strategy:?}: {mean} vs {expected}"
+            );
+        }
+        let scene = floor_scene(&[spot], None);
+        // Angles off the spot's axis: inside the inner cone, in the falloff, outside.
+        for degrees in [10.0f32, 25.0, 40.0] {
+            let r = position.y * degrees.to_radians().tan();
+            let (x, z) = (position.x + r, position.z);
+            let t = ((degrees.to_radians().cos() - outer.cos()) / (inner.cos() - outer.cos()))
+                .clamp(0.0, 1.0);
+            let expected = rho_over_pi * inverse_square(x, z, t * t);
+            let (mean, _) = estimate(&scene, view(x, z), strategy, 64);
+            assert!(
+                (mean - expected).abs().max_element() < 1e-4 * expected.max_element().max(1e-3),
+                "spot at {degrees}°, {strategy:?}: {mean} vs {expected}"
+            );
+        }
+        let scene = floor_scene(&[sun], None);
+        let expected = rho_over_pi * (irradiance * -sun_direction.y).as_dvec3();
+        let (mean, _) = estimate(&scene, view(1.0, 1.0), strategy, 64);
+        assert!(
+            (mean / expected - 1.0).abs().max_element() < 1e-4,
+            "sun, {strategy:?}: {mean} vs {expected}"
+        );
+
+        // All three with an area light: the light choice is random now, the sum must hold.
+        let radiance = Vec3::new(3.0, 2.0, 1.0);
+        let scene = floor_scene(&[point, spot, sun], Some(radiance));
+        let (x, z) = (0.5, 0.1);
+        let area = radiance.as_dvec3()
+            * albedo as f64
+            * rectangle_factor(-1.9 - 0.5, -1.1 - 0.5, -0.4 - 0.1, 0.4 - 0.1, 1.0);
+        let r = (Vec3::new(x, 0.0, z) - position).length();
+        let spot_cos = (position.y / r).clamp(-1.0, 1.0);
+        let t = ((spot_cos - outer.cos()) / (inner.cos() - outer.cos())).clamp(0.0, 1.0);
+        let expected = area
+            + rho_over_pi * (inverse_square(x, z, 1.0) + inverse_square(x, z, t * t))
+            + rho_over_pi * (irradiance * -sun_direction.y).as_dvec3();
+        let estimate = estimate(&scene, view(x, z), strategy, 200_000);
+        assert_matches(
+            &format!("all lights, {strategy:?}"),
+            estimate,
+            expected,
+            0.01,
+        );
     }
 }
 

@@ -12,15 +12,21 @@ use glam::{Affine3A, Mat4, Vec2, Vec3};
 use gltf::json::validation::Validate;
 use gltf::mesh::Mode;
 
-use super::{LoadError, Loaded};
-use crate::scene::{Camera, Material, MaterialKind, Mesh, Projection, SceneBuilder};
+use super::{GltfLightUnits, LoadError, LoadOptions, Loaded};
+use crate::scene::{
+    Camera, Light, LightKind, Material, MaterialKind, Mesh, Projection, SceneBuilder,
+};
 
 /// Extensions whose meaning gridtrace implements.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_transmission",
     "KHR_materials_ior",
+    "KHR_lights_punctual",
 ];
+
+/// Luminous efficacy the glTF specification's photometric units assume (lm/W).
+const LUMENS_PER_WATT: f32 = 683.0;
 
 /// Deepest node hierarchy accepted; deeper is treated as a cycle or an attack.
 const MAX_NODE_DEPTH: usize = 256;
@@ -30,18 +36,32 @@ const MAX_NODE_VISITS: usize = 1_000_000;
 /// which would turn them into mirrors; viewers show grey plastic, and so do we.
 const DEFAULT_ALBEDO: f32 = 0.8;
 
-/// Loads a `.gltf` or `.glb` file.
+/// Loads a `.gltf` or `.glb` file with default options.
 pub fn load(path: &Path) -> Result<Loaded, LoadError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// Loads a `.gltf` or `.glb` file.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError> {
     let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    load_bytes(&bytes, path)
+    load_bytes_with(&bytes, path, options)
+}
+
+/// Loads glTF or GLB content already in memory with default options.
+pub fn load_bytes(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
+    load_bytes_with(bytes, path, &LoadOptions::default())
 }
 
 /// Loads glTF or GLB content already in memory; `path` names it in messages and locates
 /// external buffers and images.
-pub fn load_bytes(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
+pub fn load_bytes_with(
+    bytes: &[u8],
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<Loaded, LoadError> {
     let gltf_error = |message: String| LoadError::Gltf {
         path: path.to_path_buf(),
         message,
@@ -61,6 +81,7 @@ pub fn load_bytes(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
         builder: SceneBuilder::new(),
         meshes: HashMap::new(),
         default_material: None,
+        light_units: options.gltf_light_units,
         warnings,
     };
     for material in document.materials() {
@@ -165,6 +186,7 @@ struct GltfLoader {
     /// Our mesh indices for each glTF mesh, one per triangle primitive, made on first use.
     meshes: HashMap<usize, Vec<usize>>,
     default_material: Option<usize>,
+    light_units: GltfLightUnits,
     warnings: Vec<String>,
 }
 
@@ -291,10 +313,77 @@ impl GltfLoader {
             if let Some(camera) = node.camera() {
                 self.add_camera(&camera, world, &source);
             }
+            if let Some(light) = node.light() {
+                self.add_light(&light, world, &source);
+            }
             let children: Vec<_> = node.children().map(|c| (c, world, depth + 1)).collect();
             stack.extend(children.into_iter().rev());
         }
         Ok(())
+    }
+
+    /// A `KHR_lights_punctual` light: at the node's origin, shining down its −Z axis,
+    /// converted to radiometric units by [`GltfLightUnits`].
+    fn add_light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4, source: &str) {
+        use gltf::khr_lights_punctual::Kind;
+        let name = light
+            .name()
+            .map_or_else(|| format!("light {}", light.index()), String::from);
+        let colour = Vec3::from(light.color());
+        let value = light.intensity();
+        if !value.is_finite() || value < 0.0 || !colour.is_finite() || colour.min_element() < 0.0 {
+            self.warn(format!(
+                "{source}: light '{name}' has a negative or non-finite intensity or colour; skipping it"
+            ));
+            return;
+        }
+        let directional = matches!(light.kind(), Kind::Directional);
+        let strength = match (self.light_units, directional) {
+            (GltfLightUnits::Standard, _) => value / LUMENS_PER_WATT,
+            (GltfLightUnits::Unitless, _) | (GltfLightUnits::Raw, true) => value,
+            (GltfLightUnits::Raw, false) => value / (4.0 * std::f32::consts::PI),
+        };
+        let position = world.transform_point3(Vec3::ZERO);
+        let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        let range = light.range().filter(|r| r.is_finite() && *r > 0.0);
+        if direction == Vec3::ZERO && !matches!(light.kind(), Kind::Point) {
+            self.warn(format!(
+                "{source}: light '{name}' has no direction (degenerate transform); skipping it"
+            ));
+            return;
+        }
+        let kind = match light.kind() {
+            Kind::Point => LightKind::Point {
+                position,
+                intensity: colour * strength,
+                range,
+            },
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                // The specification's bounds: 0 ≤ inner < outer ≤ π/2.
+                let outer = outer_cone_angle.clamp(0.0, std::f32::consts::FRAC_PI_2);
+                let inner = inner_cone_angle.clamp(0.0, outer);
+                LightKind::Spot {
+                    position,
+                    direction,
+                    intensity: colour * strength,
+                    cos_inner: inner.cos(),
+                    cos_outer: outer.cos(),
+                    range,
+                }
+            }
+            Kind::Directional => LightKind::Directional {
+                direction,
+                irradiance: colour * strength,
+            },
+        };
+        self.builder.add_light(Light {
+            name,
+            kind,
+            source: source.to_string(),
+        });
     }
 
     fn add_camera(&mut self, camera: &gltf::Camera, world: Mat4, source: &str) {

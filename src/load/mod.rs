@@ -20,10 +20,37 @@ pub struct Loaded {
     pub warnings: Vec<String>,
 }
 
+/// How to read what a file leaves to convention.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Units of glTF punctual light intensities.
+    pub gltf_light_units: GltfLightUnits,
+}
+
+/// What a glTF file's `KHR_lights_punctual` intensities mean. Blender's exporter offers all
+/// three ("Lighting Mode"); each is converted to radiant intensity (W/sr) for point and spot
+/// lights and irradiance (W/m²) for directional lights, which is what Blender's own watts
+/// mean to Cycles, so exported lights keep their balance with emissive surfaces.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum GltfLightUnits {
+    /// The glTF specification: candela and lux, at 683 lm/W (Blender's "Standard").
+    #[default]
+    Standard,
+    /// Watts per steradian and W/m² as written (Blender's "Unitless").
+    Unitless,
+    /// Blender's "Raw": point and spot lights in watts of emitted power, directional in W/m².
+    Raw,
+}
+
+/// Loads a scene with default options; see [`load_scene_with`].
+pub fn load_scene(path: &Path) -> Result<Loaded, LoadError> {
+    load_scene_with(path, &LoadOptions::default())
+}
+
 /// Loads a scene, choosing the loader by file extension, and warns about triangles that
 /// will never be hit (no area, or non-finite corners).
-pub fn load_scene(path: &Path) -> Result<Loaded, LoadError> {
-    let mut loaded = load_by_format(path)?;
+pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError> {
+    let mut loaded = load_by_format(path, options)?;
     for mesh in &loaded.scene.meshes {
         let (mut non_finite, mut zero_area) = (0usize, 0usize);
         for &[a, b, c] in &mesh.indices {
@@ -54,13 +81,13 @@ pub fn load_scene(path: &Path) -> Result<Loaded, LoadError> {
     Ok(loaded)
 }
 
-fn load_by_format(path: &Path) -> Result<Loaded, LoadError> {
+fn load_by_format(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     if name.ends_with(".gltf") || name.ends_with(".glb") {
-        gltf::load(path)
+        gltf::load_with(path, options)
     } else if name.ends_with(".ply") || name.ends_with(".ply.gz") {
         ply::load(path)
     } else {

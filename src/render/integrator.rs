@@ -108,8 +108,11 @@ impl Renderer<'_> {
             };
             let bsdf = self.bsdfs[s.material];
 
-            // Sample a light for the next-event estimate.
-            if !bsdf.is_delta() && strategy != Strategy::BsdfOnly {
+            // Sample a light for the next-event estimate. Punctual lights can only be found
+            // this way, so even the BSDF-only estimator samples them.
+            if !bsdf.is_delta()
+                && (strategy != Strategy::BsdfOnly || self.lights.punctual_len() > 0)
+            {
                 result.rays += 1;
                 result.radiance += beta * self.direct_light(&bsdf, &s, ng, ns, wo, rng, strategy);
             }
@@ -167,7 +170,12 @@ impl Renderer<'_> {
     ) -> Vec3 {
         let u_light = rng.uniform();
         let u = rng.uniform2();
-        let Some(ls) = self.lights.sample(s.point, u_light, u) else {
+        let sample = if strategy == Strategy::BsdfOnly {
+            self.lights.sample_punctual(s.point, u_light)
+        } else {
+            self.lights.sample(s.point, u_light, u)
+        };
+        let Some(ls) = sample else {
             return Vec3::ZERO;
         };
         if ls.radiance == Vec3::ZERO || ng.dot(ls.wi) <= 0.0 {
@@ -191,7 +199,7 @@ impl Renderer<'_> {
             return Vec3::ZERO;
         }
         let weight = match strategy {
-            Strategy::Mis => power_heuristic(ls.pdf, bsdf.pdf(ns, wo, ls.wi)),
+            Strategy::Mis if !ls.is_delta => power_heuristic(ls.pdf, bsdf.pdf(ns, wo, ls.wi)),
             _ => 1.0,
         };
         f * ls.radiance * (weight / ls.pdf)

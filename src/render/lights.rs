@@ -1,11 +1,13 @@
-//! Area lights: every triangle of an emissive material, in world space, chosen for
-//! next-event estimation in proportion to its emitted power.
+//! The lights next-event estimation samples: every triangle of an emissive material, in
+//! world space, and every punctual light, each chosen in proportion to its emitted power.
+
+use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
 use super::sampling::{Distribution1d, uniform_triangle};
 use super::surface::{interpolate_with_error, transform_point_with_error};
-use crate::scene::Scene;
+use crate::scene::{LightKind, Scene};
 
 /// One emitting triangle in world space.
 #[derive(Clone, Copy, Debug)]
@@ -34,14 +36,27 @@ pub struct LightSample {
     pub distance: f32,
     /// Radiance leaving the light towards the shading point.
     pub radiance: Vec3,
-    /// Solid-angle density of `wi` at the shading point.
+    /// Solid-angle density of `wi` at the shading point; for a punctual light, the
+    /// probability of having picked it.
     pub pdf: f32,
+    /// True for a punctual light: `radiance` is then the irradiance it brings to a surface
+    /// facing it, and no ray can find the light, so there is nothing to weigh against.
+    pub is_delta: bool,
 }
 
-/// All emissive triangles of a scene and the distribution used to pick them.
+/// All emissive triangles and punctual lights of a scene, and the distributions used to
+/// pick them.
 pub struct LightSet {
     triangles: Vec<EmissiveTriangle>,
+    punctual: Vec<LightKind>,
+    /// Over the triangles, then the punctual lights.
     distribution: Distribution1d,
+    /// Over the punctual lights alone, for estimators that find area lights by hitting them.
+    punctual_distribution: Distribution1d,
+    /// Radius of a sphere around the scene's geometry: directional lights are sampled from
+    /// beyond it, and their power is what crosses its disc.
+    scene_radius: f32,
+    scene_center: Vec3,
     /// For each instance, the index of its mesh's first triangle in `triangles`, if emissive.
     first_of_instance: Vec<Option<u32>>,
 }
@@ -88,16 +103,32 @@ impl LightSet {
                 });
             }
         }
+        let bounds = scene.bounds();
+        let (scene_center, scene_radius) = if bounds.is_empty() {
+            (Vec3::ZERO, 0.0)
+        } else {
+            (bounds.center(), 0.5 * bounds.extent().length())
+        };
+        let punctual: Vec<LightKind> = scene.lights.iter().map(|l| l.kind).collect();
+        let punctual_weights: Vec<f32> = punctual
+            .iter()
+            .map(|l| punctual_power(l, scene_radius))
+            .collect();
         let weights = triangles
             .iter()
             .map(|t| {
                 let sides = if t.double_sided { 2.0 } else { 1.0 };
-                t.area * sides * std::f32::consts::PI * t.radiance.element_sum() / 3.0
+                t.area * sides * PI * t.radiance.element_sum() / 3.0
             })
+            .chain(punctual_weights.iter().copied())
             .collect();
         LightSet {
             triangles,
+            punctual,
             distribution: Distribution1d::new(weights),
+            punctual_distribution: Distribution1d::new(punctual_weights),
+            scene_radius,
+            scene_center,
             first_of_instance,
         }
     }
@@ -112,6 +143,11 @@ impl LightSet {
         self.triangles.len()
     }
 
+    /// Number of punctual lights.
+    pub fn punctual_len(&self) -> usize {
+        self.punctual.len()
+    }
+
     /// Total emitted power (W), summed over channels' mean.
     pub fn total_power(&self) -> f64 {
         self.distribution.total()
@@ -121,7 +157,9 @@ impl LightSet {
     /// point on it; the area density is turned into solid angle by distance²/|cos θ_light|.
     pub fn sample(&self, p: Vec3, u_light: f32, u: Vec2) -> Option<LightSample> {
         let (index, pmf) = self.distribution.sample(u_light)?;
-        let tri = &self.triangles[index];
+        let Some(tri) = self.triangles.get(index) else {
+            return self.sample_punctual_light(index - self.triangles.len(), pmf, p);
+        };
         let b = uniform_triangle(u);
         let (point, point_error) = interpolate_with_error(tri.corners, [1.0 - b.x - b.y, b.x, b.y]);
         let to_light = point - p;
@@ -149,6 +187,49 @@ impl LightSet {
             distance,
             radiance,
             pdf,
+            is_delta: false,
+        })
+    }
+
+    /// Draws a punctual light alone, by power, for shading point `p`.
+    pub fn sample_punctual(&self, p: Vec3, u_light: f32) -> Option<LightSample> {
+        let (index, pmf) = self.punctual_distribution.sample(u_light)?;
+        self.sample_punctual_light(index, pmf, p)
+    }
+
+    /// The contribution of punctual light `index`, picked with probability `pmf`, at `p`.
+    fn sample_punctual_light(&self, index: usize, pmf: f32, p: Vec3) -> Option<LightSample> {
+        let light = &self.punctual[index];
+        let (point, radiance) = match *light {
+            LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
+                let distance = position.distance(p);
+                if distance == 0.0 {
+                    return None;
+                }
+                let wi = (position - p) / distance;
+                let intensity = light.intensity_towards(-wi, distance);
+                (position, intensity / (distance * distance))
+            }
+            LightKind::Directional {
+                direction,
+                irradiance,
+            } => {
+                // From beyond the scene, so the shadow ray crosses all of it.
+                let far = 2.0 * self.scene_radius + p.distance(self.scene_center) + 1.0;
+                (p - far * direction, irradiance)
+            }
+        };
+        let distance = point.distance(p);
+        let wi = (point - p) / distance;
+        Some(LightSample {
+            point,
+            point_error: Vec3::ZERO,
+            normal: -wi,
+            wi,
+            distance,
+            radiance,
+            pdf: pmf,
+            is_delta: true,
         })
     }
 
@@ -164,5 +245,26 @@ impl LightSet {
             return 0.0;
         }
         self.distribution.pmf(index) / tri.area * distance * distance / cos_light.abs()
+    }
+}
+
+/// Emitted power of a punctual light, mean over channels (W), for choosing lights: a spot
+/// counts its cone up to halfway through the falloff; a directional light, what crosses the
+/// scene's bounding disc.
+fn punctual_power(light: &LightKind, scene_radius: f32) -> f32 {
+    match *light {
+        LightKind::Point { intensity, .. } => 4.0 * PI * intensity.element_sum() / 3.0,
+        LightKind::Spot {
+            intensity,
+            cos_inner,
+            cos_outer,
+            ..
+        } => {
+            let solid_angle = 2.0 * PI * (1.0 - 0.5 * (cos_inner + cos_outer));
+            solid_angle * intensity.element_sum() / 3.0
+        }
+        LightKind::Directional { irradiance, .. } => {
+            PI * scene_radius * scene_radius * irradiance.element_sum() / 3.0
+        }
     }
 }

@@ -2,7 +2,7 @@
 
 use glam::{Affine3A, Vec3};
 
-use super::{Camera, Instance, Material, Mesh, Scene};
+use super::{Camera, Instance, Light, Material, Mesh, Scene};
 
 /// Builds a [`Scene`] piece by piece.
 ///
@@ -81,6 +81,11 @@ impl SceneBuilder {
     /// Adds a camera.
     pub fn add_camera(&mut self, camera: Camera) {
         self.scene.cameras.push(camera);
+    }
+
+    /// Adds a punctual light.
+    pub fn add_light(&mut self, light: Light) {
+        self.scene.lights.push(light);
     }
 
     /// The finished scene.

@@ -6,11 +6,13 @@
 
 mod builder;
 mod camera;
+mod light;
 mod material;
 mod mesh;
 
 pub use builder::SceneBuilder;
 pub use camera::{Camera, Projection};
+pub use light::{Light, LightKind};
 pub use material::{Material, MaterialKind};
 pub use mesh::Mesh;
 
@@ -110,6 +112,8 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Cameras found in the file, in file order.
     pub cameras: Vec<Camera>,
+    /// Punctual lights (point, spot, directional); emissive surfaces are not listed here.
+    pub lights: Vec<Light>,
 }
 
 impl Scene {
@@ -124,12 +128,13 @@ impl Scene {
         })
     }
 
-    /// True when some instanced mesh has an emissive material.
+    /// True when some instanced mesh has an emissive material or there is a punctual light.
     pub fn has_emitters(&self) -> bool {
-        self.instances.iter().any(|inst| {
-            let mesh = &self.meshes[inst.mesh];
-            self.materials[mesh.material].is_emissive() && !mesh.indices.is_empty()
-        })
+        !self.lights.is_empty()
+            || self.instances.iter().any(|inst| {
+                let mesh = &self.meshes[inst.mesh];
+                self.materials[mesh.material].is_emissive() && !mesh.indices.is_empty()
+            })
     }
 
     /// Number of triangles after instancing.

@@ -1,0 +1,124 @@
+//! Lights without area (glTF `KHR_lights_punctual`): they are reached only by sampling them,
+//! never by a ray, so the integrator handles them apart from emissive surfaces.
+
+use glam::Vec3;
+
+/// What a punctual light is and where it shines, in world space and radiometric units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Emits `intensity` (W/sr) equally in all directions from `position`.
+    Point {
+        /// Where the light is.
+        position: Vec3,
+        /// Radiant intensity per channel (W/sr).
+        intensity: Vec3,
+        /// Distance beyond which the light has no effect (glTF `range`); `None`: unlimited.
+        range: Option<f32>,
+    },
+    /// A point light restricted to a cone around `direction`, fading between the inner and
+    /// the outer cone angle as the glTF specification describes.
+    Spot {
+        /// Where the light is.
+        position: Vec3,
+        /// Unit axis of the cone, the direction the light travels.
+        direction: Vec3,
+        /// Radiant intensity on the axis (W/sr).
+        intensity: Vec3,
+        /// Cosine of the angle within which the light is at full intensity.
+        cos_inner: f32,
+        /// Cosine of the angle beyond which the light is dark.
+        cos_outer: f32,
+        /// Distance beyond which the light has no effect; `None`: unlimited.
+        range: Option<f32>,
+    },
+    /// Parallel light from infinitely far away, like the sun.
+    Directional {
+        /// Unit direction the light travels.
+        direction: Vec3,
+        /// Irradiance on a surface facing the light (W/m²).
+        irradiance: Vec3,
+    },
+}
+
+/// A named punctual light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    /// Name for messages.
+    pub name: String,
+    /// Kind, placement and strength.
+    pub kind: LightKind,
+    /// Where this light came from, for messages.
+    pub source: String,
+}
+
+impl LightKind {
+    /// Radiant intensity (W/sr) towards `wo`, a unit direction leaving the light, at
+    /// distance `distance`: the spot cone and the range window applied. Not for
+    /// directional lights, which have no intensity.
+    pub fn intensity_towards(&self, wo: Vec3, distance: f32) -> Vec3 {
+        match *self {
+            LightKind::Point {
+                intensity, range, ..
+            } => intensity * range_window(distance, range),
+            LightKind::Spot {
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+                range,
+                ..
+            } => {
+                intensity
+                    * spot_falloff(direction.dot(wo), cos_inner, cos_outer)
+                    * range_window(distance, range)
+            }
+            LightKind::Directional { .. } => Vec3::ZERO,
+        }
+    }
+}
+
+/// The glTF `KHR_lights_punctual` spot attenuation: linear in the cosine between the outer
+/// and inner cone, squared.
+fn spot_falloff(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    let scale = 1.0 / (cos_inner - cos_outer).max(1e-3);
+    let t = ((cos_angle - cos_outer) * scale).clamp(0.0, 1.0);
+    t * t
+}
+
+/// The window the glTF specification recommends for `range`, which takes the light to zero
+/// smoothly at that distance instead of cutting it off: (1 − (d/range)⁴)², clamped.
+fn range_window(distance: f32, range: Option<f32>) -> f32 {
+    match range {
+        Some(r) if r > 0.0 => {
+            let x = distance / r;
+            (1.0 - x * x * x * x).clamp(0.0, 1.0).powi(2)
+        }
+        _ => 1.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spot_is_full_inside_the_inner_cone_and_dark_outside_the_outer() {
+        let (inner, outer) = (20f32.to_radians().cos(), 30f32.to_radians().cos());
+        assert_eq!(spot_falloff(1.0, inner, outer), 1.0);
+        assert_eq!(spot_falloff(inner, inner, outer), 1.0);
+        assert_eq!(spot_falloff(outer, inner, outer), 0.0);
+        assert_eq!(spot_falloff(0.5, inner, outer), 0.0);
+        let halfway = spot_falloff(0.5 * (inner + outer), inner, outer);
+        assert!((halfway - 0.25).abs() < 1e-5, "{halfway}");
+    }
+
+    #[test]
+    fn range_window_fades_to_zero_at_the_range() {
+        assert_eq!(range_window(5.0, None), 1.0);
+        assert_eq!(range_window(0.0, Some(2.0)), 1.0);
+        assert_eq!(range_window(2.0, Some(2.0)), 0.0);
+        assert_eq!(range_window(3.0, Some(2.0)), 0.0);
+        let w = range_window(1.0, Some(2.0));
+        assert!((w - (1.0f32 - 1.0 / 16.0).powi(2)).abs() < 1e-6);
+    }
+}
