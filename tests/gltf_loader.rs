@@ -5,8 +5,8 @@ mod common;
 use common::{quad_document, write_gltf};
 use glam::{Affine3A, Quat, Vec3};
 use gridtrace::cli::choose_camera;
-use gridtrace::load::{LoadError, load_scene};
-use gridtrace::scene::{MaterialKind, Projection};
+use gridtrace::load::{GltfLightUnits, LoadError, LoadOptions, load_scene, load_scene_with};
+use gridtrace::scene::{LightKind, MaterialKind, Projection};
 use serde_json::json;
 
 fn approx(a: Vec3, b: Vec3) -> bool {
@@ -386,4 +386,157 @@ fn the_bundled_cornell_box_loads_as_blender_wrote_it() {
                 && matches!(k, MaterialKind::Glass { ior, .. } if *ior == 1.5)),
         "{kinds:?}"
     );
+}
+
+/// `KHR_lights_punctual` in each of Blender's lighting modes: the values are what Blender
+/// 5.0 writes for a 40 W point light, a 40 W spot and a 3 W/m² sun (Standard: 2174.06 cd and
+/// 2049 lux; Unitless: 3.183 and 3; Raw: 40 and 3), and each must come back as Cycles'
+/// 40/(4π) W/sr and 3 W/m².
+#[test]
+fn punctual_lights_load_in_each_of_blenders_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (GltfLightUnits::Standard, 2174.0565, 2049.0),
+        (GltfLightUnits::Unitless, 3.183_098_8, 3.0),
+        (GltfLightUnits::Raw, 40.0, 3.0),
+    ];
+    let expected_intensity = 40.0 / (4.0 * std::f32::consts::PI);
+    for (units, point_value, sun_value) in cases {
+        let mut doc = quad_document();
+        doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+        doc["extensionsRequired"] = json!(["KHR_lights_punctual"]);
+        doc["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+            {"type": "point", "intensity": point_value, "color": [1.0, 0.5, 0.25], "name": "bulb"},
+            {"type": "spot", "intensity": point_value, "range": 10.0,
+             "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.5}},
+            {"type": "directional", "intensity": sun_value}
+        ]}});
+        // The spot is turned 90° about X: its −Z axis then points along +Y.
+        let s = std::f32::consts::FRAC_1_SQRT_2;
+        doc["nodes"] = json!([
+            {"mesh": 0},
+            {"translation": [1.0, 2.0, 3.0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"rotation": [s, 0.0, 0.0, s], "extensions": {"KHR_lights_punctual": {"light": 1}}},
+            {"extensions": {"KHR_lights_punctual": {"light": 2}}}
+        ]);
+        doc["scenes"] = json!([{"nodes": [0, 1, 2, 3]}]);
+        let path = write_gltf(dir.path(), "lights.gltf", &doc);
+        let options = LoadOptions {
+            gltf_light_units: units,
+        };
+        let loaded = load_scene_with(&path, &options).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        let lights = &loaded.scene.lights;
+        assert_eq!(lights.len(), 3);
+        assert_eq!(lights[0].name, "bulb");
+        let close = |a: f32, b: f32| (a - b).abs() < 1e-4 * b.abs().max(1.0);
+        match lights[0].kind {
+            LightKind::Point {
+                position,
+                intensity,
+                range,
+            } => {
+                assert!(approx(position, Vec3::new(1.0, 2.0, 3.0)));
+                assert!(
+                    close(intensity.x, expected_intensity),
+                    "{units:?}: {intensity}"
+                );
+                assert!(close(intensity.y, 0.5 * expected_intensity));
+                assert_eq!(range, None);
+            }
+            other => panic!("{other:?}"),
+        }
+        match lights[1].kind {
+            LightKind::Spot {
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+                range,
+                ..
+            } => {
+                assert!(approx(direction, Vec3::Y), "{direction}");
+                assert!(close(intensity.x, expected_intensity));
+                assert!(close(cos_inner, 0.3f32.cos()) && close(cos_outer, 0.5f32.cos()));
+                assert_eq!(range, Some(10.0));
+            }
+            other => panic!("{other:?}"),
+        }
+        match lights[2].kind {
+            LightKind::Directional {
+                direction,
+                irradiance,
+            } => {
+                assert!(approx(direction, Vec3::NEG_Z));
+                assert!(close(irradiance.x, 3.0), "{units:?}: {irradiance}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}
+
+#[test]
+fn bad_punctual_lights_are_skipped_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = quad_document();
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+    doc["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+        {"type": "point", "intensity": -5.0, "name": "negative"}
+    ]}});
+    doc["nodes"] = json!([{"mesh": 0}, {"extensions": {"KHR_lights_punctual": {"light": 0}}}]);
+    doc["scenes"] = json!([{"nodes": [0, 1]}]);
+    let loaded = load_scene(&write_gltf(dir.path(), "bad_light.gltf", &doc)).unwrap();
+    assert!(loaded.scene.lights.is_empty());
+    assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+    assert!(
+        loaded.warnings[0].contains("bad_light.gltf") && loaded.warnings[0].contains("negative"),
+        "{:?}",
+        loaded.warnings
+    );
+}
+
+/// Blender's own export of point, spot and sun lights (tests/scenes/punctual_lights.glb):
+/// all three arrive, at Cycles' strengths.
+#[test]
+fn blender_exported_lights_arrive_at_cycles_strengths() {
+    let loaded = load_scene(std::path::Path::new("tests/scenes/punctual_lights.glb")).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let lights = &loaded.scene.lights;
+    assert_eq!(lights.len(), 3, "{lights:?}");
+    let by_name = |n: &str| lights.iter().find(|l| l.name == n).unwrap().kind;
+    let four_pi = 4.0 * std::f32::consts::PI;
+    match by_name("Point") {
+        // 60 W, colour (1, 0.8, 0.6); Blender (x, y, z) = (0.9, −0.6, 1.6) is glTF (x, z, −y).
+        LightKind::Point {
+            position,
+            intensity,
+            ..
+        } => {
+            assert!(approx(position, Vec3::new(0.9, 1.6, 0.6)), "{position}");
+            assert!((intensity.x - 60.0 / four_pi).abs() < 1e-3, "{intensity}");
+        }
+        other => panic!("{other:?}"),
+    }
+    match by_name("Spot") {
+        // 200 W pointing straight down, a 50° cone with no blend.
+        LightKind::Spot {
+            direction,
+            intensity,
+            cos_inner,
+            cos_outer,
+            ..
+        } => {
+            assert!(approx(direction, Vec3::NEG_Y), "{direction}");
+            assert!((intensity.x - 200.0 / four_pi).abs() < 1e-3, "{intensity}");
+            assert!((cos_outer - 25f32.to_radians().cos()).abs() < 1e-5);
+            assert!((cos_inner - cos_outer).abs() < 1e-5);
+        }
+        other => panic!("{other:?}"),
+    }
+    match by_name("Sun") {
+        LightKind::Directional { irradiance, .. } => {
+            assert!((irradiance.x - 1.5 * 0.8).abs() < 1e-4, "{irradiance}");
+        }
+        other => panic!("{other:?}"),
+    }
 }

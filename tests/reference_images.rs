@@ -317,3 +317,10 @@ fn error_falls_as_one_over_root_spp() {
         "RMSE against the reference falls with slope {slope:.3}, not −0.5: {points:?}"
     );
 }
+
+/// Blender point, spot and sun lights exported as `KHR_lights_punctual` (Standard units)
+/// next to an emissive panel: the balance between them must be Cycles'.
+#[test]
+fn blender_punctual_lights_match_cycles() {
+    check_scene("punctual_lights", 512);
+}

@@ -123,11 +123,12 @@ def cornell_shell(scene):
     return white
 
 
-def export(path):
+def export(path, lights=False):
     bpy.ops.export_scene.gltf(
         filepath=path,
         export_format="GLB",
         export_cameras=True,
+        export_lights=lights,
         export_yup=True,
         export_apply=True,
     )

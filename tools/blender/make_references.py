@@ -96,12 +96,53 @@ def build_coloured_lights(scene):
     add_camera(scene, (-1.2, -1.8, 1.4), (0.4, 1.0, 0.7), 60.0)
 
 
+def add_light(name, kind, energy, location, colour=(1.0, 1.0, 1.0), rotation=(0.0, 0.0, 0.0), **settings):
+    """A Blender light as a true point (radius 0, no soft falloff) or an exact sun (angle 0),
+    which is what glTF's punctual lights are."""
+    data = bpy.data.lights.new(name, kind)
+    data.energy = energy
+    data.color = colour
+    if kind == "SUN":
+        data.angle = 0.0
+    else:
+        data.shadow_soft_size = 0.0
+        data.use_soft_falloff = False
+    for key, value in settings.items():
+        setattr(data, key, value)
+    obj = bpy.data.objects.new(name, data)
+    obj.location = location
+    obj.rotation_euler = [math.radians(a) for a in rotation]
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def build_punctual_lights(scene):
+    """A point light, a hard-edged spot light and a sun, with a small emissive panel: exported
+    in Blender's Standard lighting mode, their balance with the panel is Blender's."""
+    floor = principled("Floor", (0.8, 0.8, 0.8))
+    wall = principled("Wall", (0.5, 0.55, 0.7))
+    red = principled("Red", (0.7, 0.15, 0.1))
+    panel = principled("Panel", (0.0, 0.0, 0.0), emission=(0.3, 1.0, 0.4), strength=6.0)
+    panel.use_backface_culling = True
+    quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], floor)
+    quad("BackWall", [(-3, 2, 0), (3, 2, 0), (3, 2, 3), (-3, 2, 3)], wall)
+    quad("LeftWall", [(-2, -3, 0), (-2, 3, 0), (-2, 3, 3), (-2, -3, 3)], red)
+    quad("Panel", [(0.6, 1.99, 1.2), (1.4, 1.99, 1.2), (1.4, 1.99, 1.6), (0.6, 1.99, 1.6)], panel)
+    box("Box", floor, (0.6, 0.6, 0.6), (0.7, 0.3, 0.0), 25.0)
+    sphere("Ball", principled("Ball", (0.3, 0.5, 0.8)), 0.4, (-0.7, 0.2, 0.4))
+    add_light("Point", "POINT", 60.0, (0.9, -0.6, 1.6), colour=(1.0, 0.8, 0.6))
+    add_light("Spot", "SPOT", 200.0, (-0.8, 0.3, 2.6), spot_size=math.radians(50.0), spot_blend=0.0)
+    add_light("Sun", "SUN", 1.5, (0.0, 0.0, 5.0), colour=(0.8, 0.9, 1.0), rotation=(35.0, 0.0, 40.0))
+    add_camera(scene, (0.0, -5.0, 2.2), (0.0, 0.0, 0.6), 45.0)
+
+
 # name -> (builder, directory of the exported .glb, total reference samples)
 SCENE_TABLE = {
     "cornell_box": (build_cornell_box, os.path.join(ROOT, "assets"), 8192),
     "cornell_spheres": (build_cornell_spheres, os.path.join(ROOT, "assets"), 8192),
     "caustic": (build_caustic, SCENES, 8192),
     "coloured_lights": (build_coloured_lights, SCENES, 4096),
+    "punctual_lights": (build_punctual_lights, SCENES, 4096),
 }
 
 
@@ -235,7 +276,7 @@ def main():
         scene = reset()
         build(scene)
         if not args.no_export:
-            export(os.path.join(directory, f"{name}.glb"))
+            export(os.path.join(directory, f"{name}.glb"), lights=bool(bpy.data.lights))
         for mat in bpy.data.materials:
             if mat.node_tree and mat.node_tree.nodes.get("Principled BSDF"):
                 use_exact_models(mat)
