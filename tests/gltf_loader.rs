@@ -183,7 +183,19 @@ fn materials_map_by_the_table() {
     doc["meshes"] =
         json!([{"primitives": (0..7).map(Some).chain([None]).map(prim).collect::<Vec<_>>()}]);
     let loaded = load_scene(&write_gltf(dir.path(), "m.gltf", &doc)).unwrap();
-    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    // glTF's default roughness is 1: each rough mirror or glass is named once.
+    assert_eq!(loaded.warnings.len(), 3, "{:?}", loaded.warnings);
+    for (warning, name) in loaded
+        .warnings
+        .iter()
+        .zip(["'glass'", "'metal'", "'glass default ior'"])
+    {
+        assert!(
+            warning.contains(name)
+                && warning.contains("roughness 1 is rendered as perfectly smooth"),
+            "{warning}"
+        );
+    }
     let m = &loaded.scene.materials;
     assert_eq!(m[0].emission, Vec3::new(4.0, 2.0, 1.0));
     assert!(matches!(m[0].kind, MaterialKind::Diffuse { albedo } if albedo == Vec3::ONE));

@@ -5,16 +5,19 @@
 //! `KHR_materials_ior` (default 1.5) tinted by the base colour; else `metallicFactor` ≥ 0.5 →
 //! mirror with reflectance = base colour; else Lambertian with the base colour.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
-use glam::{Affine3A, Mat4, Vec2, Vec3};
+use glam::{Affine2, Affine3A, Mat4, Vec2, Vec3, Vec4};
 use gltf::json::validation::Validate;
 use gltf::mesh::Mode;
 
+use super::images::texture_from_image;
+use super::tangents::generate_tangents;
 use super::{GltfLightUnits, LoadError, LoadOptions, Loaded};
 use crate::scene::{
-    Camera, Light, LightKind, Material, MaterialKind, Mesh, Projection, SceneBuilder,
+    AlphaMode, Camera, Filter, Light, LightKind, Material, MaterialKind, MaterialTextures, Mesh,
+    Projection, SceneBuilder, TextureRef, Wrap,
 };
 
 /// Extensions whose meaning gridtrace implements.
@@ -23,7 +26,16 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_transmission",
     "KHR_materials_ior",
     "KHR_lights_punctual",
+    "KHR_texture_transform",
+    "KHR_materials_volume",
 ];
+
+/// Texture-coordinate sets read (`TEXCOORD_0` to `TEXCOORD_3`).
+const MAX_UV_SETS: usize = 4;
+
+/// Roughness above which a mirror or glass material draws a warning that it is rendered
+/// ideal.
+const ROUGHNESS_WARNING: f32 = 0.05;
 
 /// Luminous efficacy the glTF specification's photometric units assume (lm/W).
 const LUMENS_PER_WATT: f32 = 683.0;
@@ -82,14 +94,24 @@ pub fn load_bytes_with(
         meshes: HashMap::new(),
         default_material: None,
         light_units: options.gltf_light_units,
+        images: HashMap::new(),
+        missing_images: HashSet::new(),
+        normal_mapped: Vec::new(),
+        coloured_materials: HashSet::new(),
         warnings,
     };
+    loader.warn_about_missing_images(&document, base);
     for material in document.materials() {
         let m = loader.convert_material(&material);
+        loader
+            .normal_mapped
+            .push(m.textures.normal.map(|n| n.texcoord));
         loader.builder.add_material(m);
     }
-    loader.warn_about_missing_images(&document, base);
     loader.load_scene(&document)?;
+    for &m in &loader.coloured_materials {
+        loader.builder.material_mut(m).vertex_colours = true;
+    }
     Ok(Loaded {
         scene: loader.builder.build(),
         warnings: loader.warnings,
@@ -187,6 +209,14 @@ struct GltfLoader {
     meshes: HashMap<usize, Vec<usize>>,
     default_material: Option<usize>,
     light_units: GltfLightUnits,
+    /// Our texture index for each glTF image tried so far (`None`: unusable).
+    images: HashMap<usize, Option<usize>>,
+    /// Images whose external file does not exist (already warned about).
+    missing_images: HashSet<usize>,
+    /// For each glTF material: the texture-coordinate set its normal map uses, if any.
+    normal_mapped: Vec<Option<usize>>,
+    /// glTF materials used by a primitive with vertex colours.
+    coloured_materials: HashSet<usize>,
     warnings: Vec<String>,
 }
 
@@ -209,7 +239,7 @@ impl GltfLoader {
             String::from,
         );
         let pbr = material.pbr_metallic_roughness();
-        let [r, g, b, _] = pbr.base_color_factor();
+        let [r, g, b, alpha] = pbr.base_color_factor();
         let base = Vec3::new(r, g, b);
         let emission =
             Vec3::from(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0);
@@ -226,24 +256,179 @@ impl GltfLoader {
         } else {
             MaterialKind::Diffuse { albedo: base }
         };
-        let textured = pbr.base_color_texture().is_some()
-            || pbr.metallic_roughness_texture().is_some()
-            || material.emissive_texture().is_some()
-            || material.normal_texture().is_some();
-        if textured {
+        let textures = MaterialTextures {
+            base_colour: pbr.base_color_texture().and_then(|info| {
+                self.texture_ref(
+                    &info.texture(),
+                    info.tex_coord(),
+                    info.texture_transform(),
+                    &name,
+                )
+            }),
+            emissive: material.emissive_texture().and_then(|info| {
+                self.texture_ref(
+                    &info.texture(),
+                    info.tex_coord(),
+                    info.texture_transform(),
+                    &name,
+                )
+            }),
+            metallic_roughness: pbr.metallic_roughness_texture().and_then(|info| {
+                self.texture_ref(
+                    &info.texture(),
+                    info.tex_coord(),
+                    info.texture_transform(),
+                    &name,
+                )
+            }),
+            metallic_factor: pbr.metallic_factor(),
+            normal: material
+                .normal_texture()
+                .and_then(|info| self.texture_ref(&info.texture(), info.tex_coord(), None, &name)),
+            normal_scale: material.normal_texture().map_or(1.0, |n| n.scale()),
+        };
+        let roughness = pbr.roughness_factor();
+        let ideal = matches!(
+            kind,
+            MaterialKind::Mirror { .. } | MaterialKind::Glass { .. }
+        ) || textures.metallic_roughness.is_some();
+        if ideal && roughness > ROUGHNESS_WARNING {
             self.warn(format!(
-                "material '{name}': textures are not supported yet; using its constant factors"
+                "material '{name}': roughness {roughness} is rendered as perfectly smooth \
+                 (gridtrace's mirror and glass are ideal)"
             ));
         }
+        let alpha_mode = match material.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => AlphaMode::Mask {
+                cutoff: material.alpha_cutoff().unwrap_or(0.5),
+            },
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
+        // Beer–Lambert: a distance d through the volume leaves attenuationColor, so
+        // σ = −ln(colour) / d per channel (KHR_materials_volume).
+        let absorption = material.volume().map_or(Vec3::ZERO, |v| {
+            let distance = v.attenuation_distance();
+            if distance.is_finite() && distance > 0.0 {
+                let colour = Vec3::from(v.attenuation_color()).clamp(Vec3::splat(1e-6), Vec3::ONE);
+                -Vec3::new(colour.x.ln(), colour.y.ln(), colour.z.ln()) / distance
+            } else {
+                Vec3::ZERO
+            }
+        });
         Material {
             name,
             kind,
             emission,
             double_sided: material.double_sided(),
+            textures,
+            vertex_colours: false,
+            alpha,
+            alpha_mode,
+            absorption,
         }
     }
 
-    /// Textures are not applied yet, but a missing image file is worth knowing about.
+    /// A material's use of a texture: its image (decoded once), sampler, coordinate set and
+    /// `KHR_texture_transform`. `None`, with a warning, when the image cannot be used; the
+    /// material then shows its constant factors, as if the texture were white (or flat).
+    fn texture_ref(
+        &mut self,
+        texture: &gltf::Texture,
+        tex_coord: u32,
+        transform: Option<gltf::texture::TextureTransform>,
+        material: &str,
+    ) -> Option<TextureRef> {
+        let image = self.image_texture(&texture.source())?;
+        let texcoord = transform
+            .as_ref()
+            .and_then(|t| t.tex_coord())
+            .unwrap_or(tex_coord) as usize;
+        if texcoord >= MAX_UV_SETS {
+            self.warn(format!(
+                "material '{material}': TEXCOORD_{texcoord} is not supported (sets 0 to {}); ignoring the texture",
+                MAX_UV_SETS - 1
+            ));
+            return None;
+        }
+        let wrap = |mode: gltf::texture::WrappingMode| match mode {
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        };
+        let sampler = texture.sampler();
+        let filter = match sampler.mag_filter() {
+            Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
+            _ => Filter::Linear,
+        };
+        // T · R · S as KHR_texture_transform defines it.
+        let transform = transform.map_or(Affine2::IDENTITY, |t| {
+            Affine2::from_scale_angle_translation(
+                Vec2::from(t.scale()),
+                t.rotation(),
+                Vec2::from(t.offset()),
+            )
+        });
+        Some(TextureRef {
+            texture: image,
+            texcoord,
+            transform,
+            wrap_u: wrap(sampler.wrap_s()),
+            wrap_v: wrap(sampler.wrap_t()),
+            filter,
+        })
+    }
+
+    /// The scene texture of a glTF image, decoded on first use.
+    fn image_texture(&mut self, image: &gltf::Image) -> Option<usize> {
+        if let Some(&known) = self.images.get(&image.index()) {
+            return known;
+        }
+        let name = image.name().map_or_else(
+            || format!("image {}", image.index()),
+            |n| format!("image {} '{n}'", image.index()),
+        );
+        let decoded = if self.missing_images.contains(&image.index()) {
+            None
+        } else if let Err(why) = self.check_image_view(image) {
+            self.warn(format!("{name}: {why}; using a neutral texture"));
+            None
+        } else {
+            let base = self.path.parent().unwrap_or(Path::new(".")).to_path_buf();
+            match gltf::image::Data::from_source(image.source(), Some(&base), &self.buffers) {
+                Ok(data) => Some(self.builder.add_texture(texture_from_image(name, &data))),
+                Err(e) => {
+                    self.warn(format!(
+                        "{name} cannot be decoded ({e}); using a neutral texture"
+                    ));
+                    None
+                }
+            }
+        };
+        self.images.insert(image.index(), decoded);
+        decoded
+    }
+
+    /// An image in a buffer view must lie inside its buffer (the gltf crate would index past
+    /// it).
+    fn check_image_view(&self, image: &gltf::Image) -> Result<(), String> {
+        if let gltf::image::Source::View { view, .. } = image.source() {
+            let buffer = self
+                .buffers
+                .get(view.buffer().index())
+                .map_or(0, |b| b.0.len());
+            let end = view.offset().checked_add(view.length());
+            if end.is_none_or(|end| end > buffer) {
+                return Err(format!(
+                    "buffer view {} runs past its buffer ({buffer} bytes)",
+                    view.index()
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// A missing image file is worth one clear warning, whether or not a texture uses it.
     fn warn_about_missing_images(&mut self, document: &gltf::Document, base: &Path) {
         for image in document.images() {
             if let gltf::image::Source::Uri { uri, .. } = image.source()
@@ -254,6 +439,7 @@ impl GltfLoader {
                     urlencoding::decode(uri).map_or_else(|_| uri.to_string(), |d| d.into_owned());
                 let file = base.join(decoded);
                 if !file.is_file() {
+                    self.missing_images.insert(image.index());
                     self.warn(format!(
                         "image {} not found: {}",
                         image.index(),
@@ -502,30 +688,68 @@ impl GltfLoader {
                 .collect::<Vec<_>>(),
             None => Vec::new(),
         };
+        // Without (usable) normals, glTF asks for flat shading: empty means face normals.
         let normals =
             if normals.len() == positions.len() && normals.iter().all(|n| *n != Vec3::ZERO) {
                 normals
             } else {
-                Mesh::compute_vertex_normals(&positions, &indices)
+                Vec::new()
             };
-        let uvs: Vec<Vec2> = match reader.read_tex_coords(0) {
-            Some(t) => t.into_f32().map(Vec2::from).collect(),
-            None => Vec::new(),
-        };
+        let mut uvs = Vec::new();
+        while uvs.len() < MAX_UV_SETS {
+            let Some(set) = reader.read_tex_coords(uvs.len() as u32) else {
+                break;
+            };
+            let set: Vec<Vec2> = set.into_f32().map(Vec2::from).collect();
+            uvs.push(if set.len() == positions.len() {
+                set
+            } else {
+                Vec::new()
+            });
+        }
+        let colours: Vec<Vec4> = reader
+            .read_colors(0)
+            .map(|c| c.into_rgba_f32().map(Vec4::from).collect())
+            .filter(|c: &Vec<Vec4>| c.len() == positions.len())
+            .unwrap_or_default();
+        let tangents: Vec<Vec4> = reader
+            .read_tangents()
+            .map(|t| t.map(Vec4::from).collect())
+            .filter(|t: &Vec<Vec4>| t.len() == positions.len())
+            .unwrap_or_default();
         if leftover != 0 {
             self.warn(format!(
                 "{name}: {leftover} index(es) left over after the last whole triangle"
             ));
         }
         let material = self.material_for(primitive);
-        Ok(Some(Mesh {
+        let gltf_material = primitive.material().index();
+        if !colours.is_empty()
+            && let Some(m) = gltf_material
+        {
+            self.coloured_materials.insert(m);
+        }
+        let mut mesh = Mesh {
             name,
             positions,
             normals,
             uvs,
+            colours,
+            tangents,
             indices,
             material,
-        }))
+        };
+        let normal_uvs = gltf_material.and_then(|m| self.normal_mapped.get(m).copied().flatten());
+        if let Some(set) = normal_uvs
+            && mesh.tangents.is_empty()
+            && !generate_tangents(&mut mesh, set)
+        {
+            self.warn(format!(
+                "{}: a normal map needs TEXCOORD_{set}, which is missing; the normal map is ignored here",
+                mesh.name
+            ));
+        }
+        Ok(Some(mesh))
     }
 
     /// Rejects accessors whose data would run past their buffer view or buffer.

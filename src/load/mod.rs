@@ -2,7 +2,9 @@
 
 mod error;
 pub mod gltf;
+mod images;
 pub mod ply;
+mod tangents;
 
 pub use error::LoadError;
 

@@ -232,9 +232,9 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
         name: name.clone(),
         positions,
         normals,
-        uvs: Vec::new(),
         indices,
         material,
+        ..Mesh::default()
     });
     builder.add_instance(mesh, glam::Affine3A::IDENTITY, name);
     Ok(Loaded {

@@ -32,6 +32,9 @@ const SHADOW_EPSILON: f32 = 1e-4;
 /// Path depth at which Russian roulette starts.
 const ROULETTE_DEPTH: u32 = 3;
 
+/// Most surfaces a ray may pass through (alpha cutouts) before it is given up on.
+const MAX_PASS_THROUGHS: u32 = 256;
+
 /// How the path reached its current vertex.
 #[derive(Clone, Copy)]
 enum Arrival {
@@ -65,32 +68,55 @@ impl Renderer<'_> {
         let mut beta = Vec3::ONE;
         let mut eta_scale = 1.0f32;
         let mut arrival = Arrival::Specular;
-        for depth in 0.. {
+        // Absorption coefficient of the glass volume the path is inside, if any.
+        let mut medium: Option<Vec3> = None;
+        // Distance from the last scattering vertex, across surfaces alpha let the ray through.
+        let mut travelled = 0.0f32;
+        let mut depth = 0;
+        let mut pass_throughs = 0;
+        loop {
             result.rays += 1;
             let Some(hit) = self.accel.intersect(&ray) else {
                 break;
             };
-            result.hit |= depth == 0;
+            let segment = hit.t * ray.direction.length();
+            travelled += segment;
+            if let Some(sigma) = medium {
+                beta *= (-sigma * segment).exp();
+            }
             let s = surface_at(self.scene, &self.frames, &hit);
+            if !self.is_present(&s, rng) {
+                // A cutout or a blended surface the ray passes: go on in the same direction.
+                pass_throughs += 1;
+                if pass_throughs > MAX_PASS_THROUGHS {
+                    break;
+                }
+                let ng = s.geometric_normal;
+                ray = Ray::new(
+                    offset_ray_origin(s.point, s.point_error, ng, ray.direction),
+                    ray.direction,
+                );
+                continue;
+            }
+            result.hit |= depth == 0;
             let wo = -ray.direction.normalize();
             let cos_o = s.geometric_normal.dot(wo);
             let front = cos_o > 0.0;
             let material = &self.scene.materials[s.material];
+            let shading = self.shade(&s);
 
             // Emission reached by the previous bounce.
             if material.is_emissive() && (front || material.double_sided) {
                 let weight = match (arrival, strategy) {
                     (Arrival::Specular, _) | (_, Strategy::BsdfOnly) => 1.0,
                     (Arrival::Scattered { .. }, Strategy::LightOnly) => 0.0,
-                    (Arrival::Scattered { pdf }, Strategy::Mis) => {
-                        let distance = hit.t * ray.direction.length();
-                        power_heuristic(
-                            pdf,
-                            self.lights.pdf(hit.instance, hit.triangle, distance, cos_o),
-                        )
-                    }
+                    (Arrival::Scattered { pdf }, Strategy::Mis) => power_heuristic(
+                        pdf,
+                        self.lights
+                            .pdf(hit.instance, hit.triangle, travelled, cos_o),
+                    ),
                 };
-                result.radiance += weight * beta * material.emission;
+                result.radiance += weight * beta * shading.emission;
             }
             if depth == max_depth || (!front && !material.double_sided) {
                 break;
@@ -101,12 +127,12 @@ impl Renderer<'_> {
             } else {
                 -s.geometric_normal
             };
-            let ns = if s.shading_normal.dot(ng) < 0.0 {
-                -s.shading_normal
+            let ns = if shading.normal.dot(ng) < 0.0 {
+                -shading.normal
             } else {
-                s.shading_normal
+                shading.normal
             };
-            let bsdf = self.bsdfs[s.material];
+            let bsdf = shading.bsdf;
 
             // Sample a light for the next-event estimate. Punctual lights can only be found
             // this way, so even the BSDF-only estimator samples them.
@@ -127,6 +153,11 @@ impl Renderer<'_> {
             }
             beta *= sample.weight;
             eta_scale *= sample.eta_scale;
+            if sample.is_transmission {
+                // Entering through the front face puts the path inside the volume.
+                medium =
+                    (front && material.absorption != Vec3::ZERO).then_some(material.absorption);
+            }
             arrival = if sample.is_delta {
                 Arrival::Specular
             } else {
@@ -136,10 +167,13 @@ impl Renderer<'_> {
                 offset_ray_origin(s.point, s.point_error, ng, sample.wi),
                 sample.wi,
             );
+            travelled = 0.0;
+            depth += 1;
+            pass_throughs = 0;
 
             // Possibly terminate the path with Russian roulette. The throughput is judged
             // without the radiance scaling of refractions, which cancels on leaving glass.
-            if depth + 1 >= ROULETTE_DEPTH {
+            if depth >= ROULETTE_DEPTH {
                 let rr = (beta / eta_scale).max_element();
                 if rr < 1.0 {
                     let q = (1.0 - rr).clamp(0.05, 0.95);
@@ -173,7 +207,7 @@ impl Renderer<'_> {
         let sample = if strategy == Strategy::BsdfOnly {
             self.lights.sample_punctual(s.point, u_light)
         } else {
-            self.lights.sample(s.point, u_light, u)
+            self.lights.sample(self.scene, s.point, u_light, u)
         };
         let Some(ls) = sample else {
             return Vec3::ZERO;
@@ -195,7 +229,7 @@ impl Renderer<'_> {
             t_min: 0.0,
             t_max: 1.0 - SHADOW_EPSILON,
         };
-        if self.accel.occluded(&shadow) {
+        if self.occluded(&shadow, rng) {
             return Vec3::ZERO;
         }
         let weight = match strategy {
@@ -203,5 +237,26 @@ impl Renderer<'_> {
             _ => 1.0,
         };
         f * ls.radiance * (weight / ls.pdf)
+    }
+
+    /// True when something blocks `shadow`. Surfaces that alpha hides do not; when the scene
+    /// has any, the segment is walked hit by hit.
+    fn occluded(&self, shadow: &Ray, rng: &mut Rng) -> bool {
+        if !self.has_cutouts {
+            return self.accel.occluded(shadow);
+        }
+        let mut ray = *shadow;
+        for _ in 0..=MAX_PASS_THROUGHS {
+            let Some(hit) = self.accel.intersect(&ray) else {
+                return false;
+            };
+            let s = surface_at(self.scene, &self.frames, &hit);
+            if self.is_present(&s, rng) {
+                return true;
+            }
+            // Go on from just past this surface towards the same end point.
+            ray.t_min = hit.t;
+        }
+        true
     }
 }

@@ -3,11 +3,14 @@
 
 use std::f32::consts::PI;
 
+use std::collections::HashMap;
+
 use glam::{Vec2, Vec3};
 
 use super::sampling::{Distribution1d, uniform_triangle};
+use super::shading::uv_at;
 use super::surface::{interpolate_with_error, transform_point_with_error};
-use crate::scene::{LightKind, Scene};
+use crate::scene::{ColorSpace, LightKind, Scene, TextureRef};
 
 /// One emitting triangle in world space.
 #[derive(Clone, Copy, Debug)]
@@ -19,6 +22,8 @@ struct EmissiveTriangle {
     area: f32,
     radiance: Vec3,
     double_sided: bool,
+    /// The emissive texture and the triangle's coordinates in it, if the emission varies.
+    texture: Option<(TextureRef, [Vec2; 3])>,
 }
 
 /// A point drawn on a light, as seen from a shading point.
@@ -75,6 +80,7 @@ impl LightSet {
             }
             first_of_instance.push(Some(triangles.len() as u32));
             let m = inst.world_from_object;
+            let texture = material.textures.emissive;
             for &[a, b, c] in &mesh.indices {
                 let corners =
                     [a, b, c].map(|i| transform_point_with_error(&m, mesh.positions[i as usize]));
@@ -100,6 +106,12 @@ impl LightSet {
                     area: if usable { area } else { 0.0 },
                     radiance: material.emission,
                     double_sided: material.double_sided,
+                    texture: texture.map(|r| {
+                        let uv = [a, b, c].map(|v| {
+                            uv_at(mesh, r.texcoord, [v as usize; 3], Vec3::new(1.0, 0.0, 0.0))
+                        });
+                        (r, uv)
+                    }),
                 });
             }
         }
@@ -114,11 +126,18 @@ impl LightSet {
             .iter()
             .map(|l| punctual_power(l, scene_radius))
             .collect();
+        // A textured emitter counts with its texture's mean.
+        let mut texture_means = HashMap::new();
         let weights = triangles
             .iter()
             .map(|t| {
                 let sides = if t.double_sided { 2.0 } else { 1.0 };
-                t.area * sides * PI * t.radiance.element_sum() / 3.0
+                let scale = t.texture.map_or(Vec3::ONE, |(r, _)| {
+                    *texture_means.entry(r.texture).or_insert_with(|| {
+                        scene.textures[r.texture].mean(ColorSpace::Srgb).truncate()
+                    })
+                });
+                t.area * sides * PI * (t.radiance * scale).element_sum() / 3.0
             })
             .chain(punctual_weights.iter().copied())
             .collect();
@@ -155,7 +174,7 @@ impl LightSet {
 
     /// Draws a point on a light for shading point `p`: a triangle by power, then a uniform
     /// point on it; the area density is turned into solid angle by distance²/|cos θ_light|.
-    pub fn sample(&self, p: Vec3, u_light: f32, u: Vec2) -> Option<LightSample> {
+    pub fn sample(&self, scene: &Scene, p: Vec3, u_light: f32, u: Vec2) -> Option<LightSample> {
         let (index, pmf) = self.distribution.sample(u_light)?;
         let Some(tri) = self.triangles.get(index) else {
             return self.sample_punctual_light(index - self.triangles.len(), pmf, p);
@@ -174,11 +193,17 @@ impl LightSet {
             return None;
         }
         let pdf = pmf / tri.area * distance_sq / cos_light.abs();
-        let radiance = if tri.double_sided || cos_light > 0.0 {
+        let mut radiance = if tri.double_sided || cos_light > 0.0 {
             tri.radiance
         } else {
             Vec3::ZERO
         };
+        if let Some((r, uvs)) = &tri.texture {
+            let uv = (1.0 - b.x - b.y) * uvs[0] + b.x * uvs[1] + b.y * uvs[2];
+            radiance *= scene.textures[r.texture]
+                .sample(r, uv, ColorSpace::Srgb)
+                .truncate();
+        }
         Some(LightSample {
             point,
             point_error,

@@ -9,6 +9,7 @@ mod film;
 mod integrator;
 mod lights;
 pub mod sampling;
+mod shading;
 mod surface;
 
 pub use bsdf::{Bsdf, BsdfSample, fresnel_dielectric};
@@ -78,8 +79,9 @@ pub struct Renderer<'a> {
     scene: &'a Scene,
     accel: SceneAccel,
     lights: LightSet,
-    bsdfs: Vec<Bsdf>,
     frames: Vec<InstanceFrame>,
+    /// True when some material has alpha cutouts or blending, so hits must be checked.
+    has_cutouts: bool,
 }
 
 impl<'a> Renderer<'a> {
@@ -89,8 +91,8 @@ impl<'a> Renderer<'a> {
             scene,
             accel: SceneAccel::build(scene),
             lights: LightSet::build(scene),
-            bsdfs: scene.materials.iter().map(|m| Bsdf(m.kind)).collect(),
             frames: InstanceFrame::for_scene(scene),
+            has_cutouts: scene.materials.iter().any(|m| m.is_cutout()),
         }
     }
 

@@ -19,6 +19,12 @@ pub struct Surface {
     pub shading_normal: Vec3,
     /// Index into [`Scene::materials`].
     pub material: usize,
+    /// Index into [`Scene::instances`].
+    pub instance: usize,
+    /// The triangle's vertex indices in its mesh.
+    pub vertices: [usize; 3],
+    /// Barycentric weights of `vertices` at the hit.
+    pub barycentrics: Vec3,
 }
 
 /// γ(n) = nε / (1 − nε), the bound on the relative error of n chained floating-point
@@ -75,7 +81,7 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
 /// Per-instance data for turning object-space geometry into world space.
 #[derive(Clone, Copy, Debug)]
 pub struct InstanceFrame {
-    world_from_object: Affine3A,
+    pub(super) world_from_object: Affine3A,
     /// Inverse transpose of the linear part: normals transform by it.
     normal_matrix: Mat3,
 }
@@ -109,15 +115,22 @@ pub fn surface_at(scene: &Scene, frames: &[InstanceFrame], hit: &SceneHit) -> Su
     let w = 1.0 - hit.u - hit.v;
     let corners = p.map(|p| transform_point_with_error(&frame.world_from_object, p));
     let (point, point_error) = interpolate_with_error(corners, [w, hit.u, hit.v]);
-    let interpolated = w * mesh.normals[a] + hit.u * mesh.normals[b] + hit.v * mesh.normals[c];
-    let shading = (frame.normal_matrix * interpolated)
-        .try_normalize()
-        .unwrap_or(geometric);
+    let shading = if mesh.normals.is_empty() {
+        geometric
+    } else {
+        let interpolated = w * mesh.normals[a] + hit.u * mesh.normals[b] + hit.v * mesh.normals[c];
+        (frame.normal_matrix * interpolated)
+            .try_normalize()
+            .unwrap_or(geometric)
+    };
     Surface {
         point,
         point_error,
         geometric_normal: geometric,
         shading_normal: shading,
         material: mesh.material,
+        instance: hit.instance as usize,
+        vertices: [a, b, c],
+        barycentrics: Vec3::new(w, hit.u, hit.v),
     }
 }

@@ -2,7 +2,7 @@
 
 use glam::{Affine3A, Vec3};
 
-use super::{Camera, Instance, Light, Material, Mesh, Scene};
+use super::{Camera, Instance, Light, Material, Mesh, Scene, Texture};
 
 /// Builds a [`Scene`] piece by piece.
 ///
@@ -53,6 +53,8 @@ impl SceneBuilder {
             positions,
             normals,
             uvs: Vec::new(),
+            colours: Vec::new(),
+            tangents: Vec::new(),
             indices,
             material,
         })
@@ -81,6 +83,17 @@ impl SceneBuilder {
     /// Adds a camera.
     pub fn add_camera(&mut self, camera: Camera) {
         self.scene.cameras.push(camera);
+    }
+
+    /// The material at `index`, to adjust after loading.
+    pub fn material_mut(&mut self, index: usize) -> &mut Material {
+        &mut self.scene.materials[index]
+    }
+
+    /// Adds a decoded image; returns its index for [`super::TextureRef::texture`].
+    pub fn add_texture(&mut self, texture: Texture) -> usize {
+        self.scene.textures.push(texture);
+        self.scene.textures.len() - 1
     }
 
     /// Adds a punctual light.

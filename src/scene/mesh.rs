@@ -1,6 +1,6 @@
 //! Triangle meshes in object space.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use super::Aabb;
 
@@ -11,10 +11,16 @@ pub struct Mesh {
     pub name: String,
     /// Vertex positions.
     pub positions: Vec<Vec3>,
-    /// Per-vertex shading normals, unit length; same length as `positions`.
+    /// Per-vertex shading normals, unit length; same length as `positions`, or empty for
+    /// flat shading with the face normal.
     pub normals: Vec<Vec3>,
-    /// Per-vertex texture coordinates; empty or same length as `positions`.
-    pub uvs: Vec<Vec2>,
+    /// Texture-coordinate sets (`TEXCOORD_n`), each empty or as long as `positions`.
+    pub uvs: Vec<Vec<Vec2>>,
+    /// Per-vertex linear RGBA colours (`COLOR_0`); empty or as long as `positions`.
+    pub colours: Vec<Vec4>,
+    /// Per-vertex tangents with the bitangent sign in w (glTF `TANGENT`, or MikkTSpace);
+    /// empty unless a normal map needs them.
+    pub tangents: Vec<Vec4>,
     /// Triangles as vertex indices, counter-clockwise seen from the front.
     pub indices: Vec<[u32; 3]>,
     /// Index into [`super::Scene::materials`].

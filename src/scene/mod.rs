@@ -9,12 +9,14 @@ mod camera;
 mod light;
 mod material;
 mod mesh;
+mod texture;
 
 pub use builder::SceneBuilder;
 pub use camera::{Camera, Projection};
 pub use light::{Light, LightKind};
-pub use material::{Material, MaterialKind};
+pub use material::{AlphaMode, Material, MaterialKind, MaterialTextures};
 pub use mesh::Mesh;
+pub use texture::{ColorSpace, Filter, Texture, TextureRef, Wrap, srgb_to_linear};
 
 use glam::{Affine3A, Vec3};
 
@@ -114,6 +116,8 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     /// Punctual lights (point, spot, directional); emissive surfaces are not listed here.
     pub lights: Vec<Light>,
+    /// Decoded images, indexed by [`TextureRef::texture`].
+    pub textures: Vec<Texture>,
 }
 
 impl Scene {

@@ -136,6 +136,120 @@ def build_punctual_lights(scene):
     add_camera(scene, (0.0, -5.0, 2.2), (0.0, 0.0, 0.6), 45.0)
 
 
+def make_image(name, size, pixel, colorspace="sRGB"):
+    """A packed 8-bit RGBA image (Blender rows run bottom to top), exported as PNG."""
+    image = bpy.data.images.new(name, size, size, alpha=True)
+    image.colorspace_settings.name = colorspace
+    pixels = []
+    for row in range(size):
+        for col in range(size):
+            pixels.extend(pixel((col + 0.5) / size, (row + 0.5) / size))
+    image.pixels = pixels
+    image.pack()
+    return image
+
+
+def textured(name, image, link_to="Base Color", colour=(1.0, 1.0, 1.0), mapping=None, normal_strength=None,
+             emission_strength=None, cutout=False):
+    """A Principled BSDF fed by an image texture, the way a Blender user wires one."""
+    mat = principled(name, colour)
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bsdf = nodes["Principled BSDF"]
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    tex.interpolation = "Linear"
+    tex.extension = "REPEAT"
+    if mapping is not None:
+        coords = nodes.new("ShaderNodeTexCoord")
+        node = nodes.new("ShaderNodeMapping")
+        node.inputs["Location"].default_value = mapping["location"]
+        node.inputs["Rotation"].default_value = mapping["rotation"]
+        node.inputs["Scale"].default_value = mapping["scale"]
+        links.new(coords.outputs["UV"], node.inputs["Vector"])
+        links.new(node.outputs["Vector"], tex.inputs["Vector"])
+    if normal_strength is not None:
+        normal_map = nodes.new("ShaderNodeNormalMap")
+        normal_map.inputs["Strength"].default_value = normal_strength
+        links.new(tex.outputs["Color"], normal_map.inputs["Color"])
+        links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
+    elif emission_strength is not None:
+        links.new(tex.outputs["Color"], bsdf.inputs["Emission Color"])
+        bsdf.inputs["Emission Strength"].default_value = emission_strength
+    else:
+        links.new(tex.outputs["Color"], bsdf.inputs[link_to])
+    if cutout:
+        # Blender's glTF exporter writes alphaMode MASK (cutoff 0.5) for a rounded alpha.
+        round_node = nodes.new("ShaderNodeMath")
+        round_node.operation = "ROUND"
+        links.new(tex.outputs["Alpha"], round_node.inputs[0])
+        links.new(round_node.outputs["Value"], bsdf.inputs["Alpha"])
+    return mat
+
+
+def build_textured(scene):
+    """Textures as Blender users wire them: a checker floor through a Mapping node
+    (KHR_texture_transform), a normal-mapped block, an emissive texture, a cutout leaf, and a
+    textured box mirrored by a negative scale."""
+    def checker(u, v):
+        odd = (int(u * 8) + int(v * 8)) % 2
+        return (0.85, 0.8, 0.7, 1.0) if odd else (0.6, 0.2, 0.1, 1.0)
+
+    def bumps(u, v):
+        # Height h = sin(2π·4u)·sin(2π·4v)/8; normal (−∂h/∂u, −∂h/∂v, 1) in tangent space.
+        k = 2 * math.pi * 4
+        dx = k * math.cos(k * u) * math.sin(k * v) / 8 * 0.15
+        dy = k * math.sin(k * u) * math.cos(k * v) / 8 * 0.15
+        n = (-dx, -dy, 1.0)
+        length = math.sqrt(sum(c * c for c in n))
+        return tuple(0.5 + 0.5 * c / length for c in n) + (1.0,)
+
+    def gradient(u, v):
+        return (u, 0.3 + 0.7 * v, 1.0 - u, 1.0)
+
+    def leaf(u, v):
+        inside = (u - 0.5) ** 2 / 0.2 + (v - 0.5) ** 2 / 0.08 < 1.0
+        return (0.2, 0.6, 0.15, 1.0 if inside else 0.0)
+
+    def arrow(u, v):
+        # An asymmetric mark, so a mirrored copy looks mirrored.
+        on = (0.2 < v < 0.4 and u > 0.2) or (0.4 <= v < 0.8 and 0.2 < u < 0.45)
+        return (0.9, 0.75, 0.2, 1.0) if on else (0.2, 0.3, 0.6, 1.0)
+
+    floor = textured("CheckerFloor", make_image("checker", 64, checker),
+                     mapping={"location": (0.1, 0.2, 0.0), "rotation": (0.0, 0.0, math.radians(30.0)),
+                              "scale": (3.0, 3.0, 1.0)})
+    bumpy = textured("Bumpy", make_image("bumps", 64, bumps, "Non-Color"), colour=(0.8, 0.8, 0.8),
+                     normal_strength=1.0)
+    glow = textured("Glow", make_image("gradient", 32, gradient), colour=(0.0, 0.0, 0.0), emission_strength=4.0)
+    leafy = textured("Leaf", make_image("leaf", 64, leaf), cutout=True)
+    marked = textured("Marked", make_image("arrow", 32, arrow))
+    light = principled("Light", (0.0, 0.0, 0.0), emission=(1.0, 0.95, 0.85), strength=6.0)
+    light.use_backface_culling = True
+
+    def uv_quad(name, corners, material):
+        obj = quad(name, corners, material)
+        uv = obj.data.uv_layers.new(name="UVMap")
+        for loop, coord in zip(obj.data.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
+            uv.data[loop.index].uv = coord
+        return obj
+
+    uv_quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], floor)
+    uv_quad("Wall", [(-3, 1.5, 0), (3, 1.5, 0), (3, 1.5, 3), (-3, 1.5, 3)], bumpy)
+    uv_quad("GlowPanel", [(-2.2, 1.45, 0.8), (-1.2, 1.45, 0.8), (-1.2, 1.45, 1.6), (-2.2, 1.45, 1.6)], glow)
+    uv_quad("Leaf", [(-0.6, -0.5, 0.2), (0.4, -0.5, 0.2), (0.4, 0.1, 1.3), (-0.6, 0.1, 1.3)], leafy)
+    bpy.ops.mesh.primitive_cube_add(size=0.6, location=(1.2, 0.2, 0.3))
+    cube = bpy.context.active_object
+    cube.data.materials.append(marked)
+    mirrored = cube.copy()
+    mirrored.data = cube.data
+    mirrored.location = (1.9, -0.4, 0.3)
+    mirrored.scale = (-1.0, 1.0, 1.0)
+    bpy.context.scene.collection.objects.link(mirrored)
+    s = 0.6
+    quad("Light", [(-s, -s - 0.5, 3), (-s, s - 0.5, 3), (s, s - 0.5, 3), (s, -s - 0.5, 3)], light)
+    add_camera(scene, (0.3, -5.0, 2.4), (0.3, 0.0, 0.6), 45.0)
+
+
 # name -> (builder, directory of the exported .glb, total reference samples)
 SCENE_TABLE = {
     "cornell_box": (build_cornell_box, os.path.join(ROOT, "assets"), 8192),
@@ -143,6 +257,7 @@ SCENE_TABLE = {
     "caustic": (build_caustic, SCENES, 8192),
     "coloured_lights": (build_coloured_lights, SCENES, 4096),
     "punctual_lights": (build_punctual_lights, SCENES, 4096),
+    "textured": (build_textured, SCENES, 4096),
 }
 
 
@@ -160,12 +275,18 @@ def principled_inputs(mat):
 
 
 def use_exact_models(mat):
-    """Rebuilds the material's node tree as gridtrace's model of the Principled inputs."""
+    """Replaces the material's Principled BSDF by gridtrace's model of its inputs, keeping
+    whatever feeds them (image textures, mappings, normal maps, alpha)."""
     p = principled_inputs(mat)
     nodes = mat.node_tree.nodes
     links = mat.node_tree.links
-    nodes.clear()
-    out = nodes.new("ShaderNodeOutputMaterial")
+    principled = nodes["Principled BSDF"]
+    out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
+
+    def source(name):
+        socket = principled.inputs[name]
+        return socket.links[0].from_socket if socket.is_linked else None
+
     if p["transmission"] >= 0.5:
         surface = nodes.new("ShaderNodeBsdfGlass")
         surface.distribution = "SHARP" if "SHARP" in _enum_items(surface, "distribution") else "GGX"
@@ -179,15 +300,30 @@ def use_exact_models(mat):
         surface = nodes.new("ShaderNodeBsdfDiffuse")
         surface.inputs["Roughness"].default_value = 0.0
     surface.inputs["Color"].default_value = (*p["colour"], 1.0)
+    if source("Base Color") is not None:
+        links.new(source("Base Color"), surface.inputs["Color"])
+    if source("Normal") is not None:
+        links.new(source("Normal"), surface.inputs["Normal"])
     shader = surface.outputs["BSDF"]
-    if p["strength"] > 0.0 and max(p["emission"]) > 0.0:
+    emission_source = source("Emission Color")
+    if p["strength"] > 0.0 and (max(p["emission"]) > 0.0 or emission_source is not None):
         emission = nodes.new("ShaderNodeEmission")
         emission.inputs["Color"].default_value = (*p["emission"], 1.0)
+        if emission_source is not None:
+            links.new(emission_source, emission.inputs["Color"])
         emission.inputs["Strength"].default_value = p["strength"]
         add = nodes.new("ShaderNodeAddShader")
         links.new(shader, add.inputs[0])
         links.new(emission.outputs["Emission"], add.inputs[1])
         shader = add.outputs["Shader"]
+    if source("Alpha") is not None:
+        # Where alpha is 0 the surface is not there: a transparent pass-through.
+        transparent = nodes.new("ShaderNodeBsdfTransparent")
+        mix = nodes.new("ShaderNodeMixShader")
+        links.new(source("Alpha"), mix.inputs["Fac"])
+        links.new(transparent.outputs["BSDF"], mix.inputs[1])
+        links.new(shader, mix.inputs[2])
+        shader = mix.outputs["Shader"]
     if mat.use_backface_culling:
         # glTF doubleSided: false, which gridtrace renders as a black, non-emitting back face.
         backfacing = nodes.new("ShaderNodeNewGeometry").outputs["Backfacing"]
@@ -198,6 +334,7 @@ def use_exact_models(mat):
         links.new(shader, mix.inputs[1])
         links.new(black.outputs["BSDF"], mix.inputs[2])
         shader = mix.outputs["Shader"]
+    nodes.remove(principled)
     links.new(shader, out.inputs["Surface"])
 
 

@@ -1,0 +1,173 @@
+//! What a material looks like at one surface point: textures, vertex colours and normal maps
+//! resolved into a BSDF, an emitted radiance and a shading normal; and the alpha that decides
+//! whether the surface is there at all.
+
+use glam::{Vec2, Vec3, Vec4};
+
+use super::Renderer;
+use super::bsdf::Bsdf;
+use super::sampling::Rng;
+use super::surface::Surface;
+use crate::scene::{AlphaMode, ColorSpace, Material, MaterialKind, Mesh, Scene, TextureRef};
+
+/// A material evaluated at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct Shading {
+    /// The scattering model with its colour.
+    pub bsdf: Bsdf,
+    /// Emitted radiance.
+    pub emission: Vec3,
+    /// Unit shading normal, normal-mapped where the material says so (not yet turned to
+    /// any side).
+    pub normal: Vec3,
+}
+
+/// Texture coordinates of set `set` at the surface point; zero if the mesh has none.
+pub fn uv_at(mesh: &Mesh, set: usize, vertices: [usize; 3], barycentrics: Vec3) -> Vec2 {
+    match mesh.uvs.get(set) {
+        Some(uvs) if !uvs.is_empty() => {
+            barycentrics.x * uvs[vertices[0]]
+                + barycentrics.y * uvs[vertices[1]]
+                + barycentrics.z * uvs[vertices[2]]
+        }
+        _ => Vec2::ZERO,
+    }
+}
+
+/// `reference` looked up at the surface point.
+pub fn texture_at(
+    scene: &Scene,
+    mesh: &Mesh,
+    reference: &TextureRef,
+    vertices: [usize; 3],
+    barycentrics: Vec3,
+    space: ColorSpace,
+) -> Vec4 {
+    let uv = uv_at(mesh, reference.texcoord, vertices, barycentrics);
+    scene.textures[reference.texture].sample(reference, uv, space)
+}
+
+impl Renderer<'_> {
+    /// The material of `s` evaluated there.
+    pub(super) fn shade(&self, s: &Surface) -> Shading {
+        let material = &self.scene.materials[s.material];
+        if !material.varies() {
+            return Shading {
+                bsdf: Bsdf(material.kind),
+                emission: material.emission,
+                normal: s.shading_normal,
+            };
+        }
+        let mesh = self.mesh_of(s);
+        let lookup = |r: &TextureRef, space| {
+            texture_at(self.scene, mesh, r, s.vertices, s.barycentrics, space)
+        };
+        let mut colour = material.kind.colour();
+        if let Some(r) = &material.textures.base_colour {
+            colour *= lookup(r, ColorSpace::Srgb).truncate();
+        }
+        if material.vertex_colours {
+            colour *= self.vertex_colour(mesh, s).truncate();
+        }
+        let mut kind = material.kind.with_colour(colour);
+        if let Some(r) = &material.textures.metallic_roughness
+            && !matches!(kind, MaterialKind::Glass { .. })
+        {
+            let metallic = material.textures.metallic_factor * lookup(r, ColorSpace::Linear).z;
+            kind = if metallic >= 0.5 {
+                MaterialKind::Mirror {
+                    reflectance: colour,
+                }
+            } else {
+                MaterialKind::Diffuse { albedo: colour }
+            };
+        }
+        let mut emission = material.emission;
+        if let Some(r) = &material.textures.emissive {
+            emission *= lookup(r, ColorSpace::Srgb).truncate();
+        }
+        let normal = match &material.textures.normal {
+            Some(r) if !mesh.tangents.is_empty() => {
+                let texel = lookup(r, ColorSpace::Linear);
+                self.normal_mapped(s, mesh, texel, material.textures.normal_scale)
+            }
+            _ => s.shading_normal,
+        };
+        Shading {
+            bsdf: Bsdf(kind),
+            emission,
+            normal,
+        }
+    }
+
+    /// True when the surface at `s` is really there for a ray: cutouts (alpha mask) are
+    /// holes, and a blended surface is there with probability alpha.
+    pub(super) fn is_present(&self, s: &Surface, rng: &mut Rng) -> bool {
+        let material = &self.scene.materials[s.material];
+        match material.alpha_mode {
+            AlphaMode::Opaque => true,
+            AlphaMode::Mask { cutoff } => self.alpha_at(material, s) >= cutoff,
+            AlphaMode::Blend => rng.uniform() < self.alpha_at(material, s),
+        }
+    }
+
+    fn alpha_at(&self, material: &Material, s: &Surface) -> f32 {
+        let mesh = self.mesh_of(s);
+        let mut alpha = material.alpha;
+        if let Some(r) = &material.textures.base_colour {
+            alpha *= texture_at(
+                self.scene,
+                mesh,
+                r,
+                s.vertices,
+                s.barycentrics,
+                ColorSpace::Linear,
+            )
+            .w;
+        }
+        if material.vertex_colours {
+            alpha *= self.vertex_colour(mesh, s).w;
+        }
+        alpha
+    }
+
+    fn mesh_of(&self, s: &Surface) -> &Mesh {
+        &self.scene.meshes[self.scene.instances[s.instance].mesh]
+    }
+
+    fn vertex_colour(&self, mesh: &Mesh, s: &Surface) -> Vec4 {
+        if mesh.colours.is_empty() {
+            return Vec4::ONE;
+        }
+        let [a, b, c] = s.vertices;
+        let w = s.barycentrics;
+        w.x * mesh.colours[a] + w.y * mesh.colours[b] + w.z * mesh.colours[c]
+    }
+
+    /// The shading normal bent by a tangent-space normal-map texel (glTF: RGB = XYZ in
+    /// [-1, 1], X along the tangent, Y along sign·N×T, XY scaled by `scale`).
+    fn normal_mapped(&self, s: &Surface, mesh: &Mesh, texel: Vec4, scale: f32) -> Vec3 {
+        let [a, b, c] = s.vertices;
+        let w = s.barycentrics;
+        let tangent = w.x * mesh.tangents[a] + w.y * mesh.tangents[b] + w.z * mesh.tangents[c];
+        let frame = &self.frames[s.instance];
+        let n = s.shading_normal;
+        let t = frame.world_from_object.matrix3 * tangent.truncate();
+        let t = (t - n * n.dot(t)).normalize_or_zero();
+        if t == Vec3::ZERO {
+            return n;
+        }
+        // A mirroring instance transform flips the bitangent's handedness.
+        let handedness =
+            mesh.tangents[a].w.signum() * frame.world_from_object.matrix3.determinant().signum();
+        let bitangent = handedness * n.cross(t);
+        let m = Vec3::new(
+            (2.0 * texel.x - 1.0) * scale,
+            (2.0 * texel.y - 1.0) * scale,
+            2.0 * texel.z - 1.0,
+        );
+        (m.x * t + m.y * bitangent + m.z * n)
+            .try_normalize()
+            .unwrap_or(n)
+    }
+}
