@@ -8,6 +8,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use crate::inspect::describe;
 use crate::load::{GltfLightUnits, LoadOptions, load_scene_with};
 use crate::output::{check_writable, write_image};
 use crate::render::{RenderSettings, Renderer, Strategy};
@@ -73,6 +74,11 @@ pub struct Args {
     #[arg(long, value_name = "N", default_value_t = 1 << 28)]
     pub max_pixels: u64,
 
+    /// Print what was loaded (meshes, materials and how they were mapped, textures, lights
+    /// with their power, cameras, warnings) and exit without rendering.
+    #[arg(long)]
+    pub inspect: bool,
+
     /// What glTF light intensities mean: the specification's candela and lux (Blender's
     /// "Standard" export), or Blender's "Unitless" or "Raw" lighting modes.
     #[arg(long, value_enum, value_name = "UNITS", default_value = "standard")]
@@ -118,6 +124,18 @@ pub fn main() -> i32 {
 /// Loads, renders and writes as `args` says; rendering stops early, and the image so far is
 /// written, once `stop` is set.
 pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
+    let options = LoadOptions {
+        gltf_light_units: args.gltf_light_units,
+    };
+    if args.inspect {
+        let loaded = load_scene_with(&args.scene, &options)?;
+        print!(
+            "{}:\n{}",
+            args.scene.display(),
+            describe(&loaded.scene, &loaded.warnings)
+        );
+        return Ok(Outcome::Completed);
+    }
     let output = args
         .output
         .clone()
@@ -130,9 +148,6 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let pool = pool.build().context("starting worker threads")?;
 
     let load_start = Instant::now();
-    let options = LoadOptions {
-        gltf_light_units: args.gltf_light_units,
-    };
     let loaded = load_scene_with(&args.scene, &options)?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");

@@ -29,6 +29,7 @@
 
 pub mod accel;
 pub mod cli;
+pub mod inspect;
 pub mod load;
 pub mod output;
 pub mod render;

@@ -8,7 +8,9 @@ use glam::{Affine3A, DVec3, Vec3};
 use gridtrace::accel::Ray;
 use gridtrace::render::sampling::Rng;
 use gridtrace::render::{RenderSettings, Renderer, Strategy};
-use gridtrace::scene::{Light, LightKind, Material, MaterialKind, Scene, SceneBuilder};
+use gridtrace::scene::{
+    AlphaMode, Light, LightKind, Material, MaterialKind, Scene, SceneBuilder, Texture, TextureRef,
+};
 use shapes::{add_box_inside, add_box_outside, add_quad, add_sphere, camera_at};
 
 const STRATEGIES: [Strategy; 3] = [Strategy::Mis, Strategy::LightOnly, Strategy::BsdfOnly];
@@ -440,6 +442,228 @@ fn objects_in_radiative_equilibrium_are_invisible() {
         assert!(
             (mean - Vec3::splat(equilibrium)).abs().max_element() < 0.01,
             "{strategy:?}: image mean {mean}"
+        );
+    }
+}
+
+/// Alpha in front of an emitter: a black surface with alpha α blended stochastically shows
+/// (1 − α)·L; a cutout shows L where alpha is under the cutoff and black elsewhere.
+#[test]
+fn alpha_blend_and_cutout_let_the_right_share_through() {
+    let radiance = Vec3::new(1.0, 2.0, 3.0);
+    for (mode, alpha, through) in [
+        (AlphaMode::Blend, 0.25f32, 0.75f64),
+        (AlphaMode::Mask { cutoff: 0.5 }, 0.2, 1.0),
+        (AlphaMode::Mask { cutoff: 0.5 }, 0.8, 0.0),
+    ] {
+        let mut b = SceneBuilder::new();
+        add_backdrop(&mut b, -3.0, radiance);
+        let veil = b.add_material(Material {
+            alpha,
+            alpha_mode: mode,
+            ..Material::diffuse("veil", Vec3::ZERO)
+        });
+        let v = Vec3::new;
+        add_quad(
+            &mut b,
+            [
+                v(-2., -2., 0.),
+                v(2., -2., 0.),
+                v(2., 2., 0.),
+                v(-2., 2., 0.),
+            ],
+            veil,
+        );
+        let scene = b.build();
+        let ray = Ray::new(v(0.1, 0.2, 2.0), v(0.0, 0.0, -1.0));
+        let expected = radiance.as_dvec3() * through;
+        for strategy in STRATEGIES {
+            let (mean, stderr) = estimate(&scene, ray, strategy, 100_000);
+            for c in 0..3 {
+                assert!(
+                    (mean[c] - expected[c]).abs() <= 4.0 * stderr[c] + 1e-6,
+                    "{mode:?} α={alpha}, {strategy:?}: {mean} ± {stderr}, expected {expected}"
+                );
+            }
+        }
+    }
+}
+
+/// Beer–Lambert inside glass: with A = exp(−σ·d) along the path through a slab of
+/// thickness d at normal incidence, the Fresnel series becomes
+/// L·(1 − F)²·A / (1 − F²·A²).
+#[test]
+fn absorbing_glass_slab_follows_beer_lambert() {
+    let (eta, radiance) = (1.5f32, Vec3::new(2.0, 1.0, 0.5));
+    let sigma = Vec3::new(0.2, 1.0, 3.0);
+    let thickness = 0.5f32;
+    let mut b = SceneBuilder::new();
+    add_backdrop(&mut b, -5.0, radiance);
+    let glass = b.add_material(Material {
+        absorption: sigma,
+        ..Material::new(
+            "glass",
+            MaterialKind::Glass {
+                ior: eta,
+                tint: Vec3::ONE,
+            },
+        )
+    });
+    add_box_outside(
+        &mut b,
+        glass,
+        Affine3A::from_scale(Vec3::new(20.0, 20.0, 0.5 * thickness)),
+    );
+    let scene = b.build();
+    let ray = Ray::new(Vec3::new(0.1, 0.2, 3.0), Vec3::NEG_Z);
+    let f = fresnel(1.0, eta as f64);
+    let a = (-sigma.as_dvec3() * thickness as f64).exp();
+    let expected = radiance.as_dvec3() * (1.0 - f) * (1.0 - f) * a / (DVec3::ONE - f * f * a * a);
+    for strategy in STRATEGIES {
+        let estimate = estimate(&scene, ray, strategy, 200_000);
+        assert_matches(
+            &format!("absorbing slab, {strategy:?}"),
+            estimate,
+            expected,
+            0.005,
+        );
+    }
+}
+
+/// Vertex colours multiply the albedo: the floor under the square light, coloured.
+#[test]
+fn vertex_colours_multiply_the_albedo() {
+    let (albedo, radiance, colour) = (
+        0.6f32,
+        Vec3::splat(2.0),
+        glam::Vec4::new(0.5, 1.0, 0.25, 1.0),
+    );
+    let mut b = SceneBuilder::new();
+    let floor = b.add_material(Material {
+        vertex_colours: true,
+        ..Material::diffuse("floor", Vec3::splat(albedo))
+    });
+    let light = b.add_material(Material {
+        double_sided: false,
+        ..Material::diffuse("light", Vec3::ZERO).with_emission(radiance)
+    });
+    let v = Vec3::new;
+    let mesh = b.add_mesh(
+        "floor",
+        vec![
+            v(-20., 0., -20.),
+            v(-20., 0., 20.),
+            v(20., 0., 20.),
+            v(20., 0., -20.),
+        ],
+        vec![[0, 1, 2], [0, 2, 3]],
+        floor,
+    );
+    b.add_instance(mesh, Affine3A::IDENTITY, "floor");
+    add_quad(
+        &mut b,
+        [
+            v(-0.4, 1., -0.4),
+            v(0.4, 1., -0.4),
+            v(0.4, 1., 0.4),
+            v(-0.4, 1., 0.4),
+        ],
+        light,
+    );
+    let mut scene = b.build();
+    scene.meshes[mesh].colours = vec![colour; 4];
+    let target = v(0.0, 0.0, 0.0);
+    let origin = target + v(4.0, 0.5, 0.3);
+    let factor = rectangle_factor(-0.4, 0.4, -0.4, 0.4, 1.0);
+    let expected = (radiance * albedo * colour.truncate()).as_dvec3() * factor;
+    let estimate = estimate(
+        &scene,
+        Ray::new(origin, target - origin),
+        Strategy::Mis,
+        100_000,
+    );
+    assert_matches("coloured floor", estimate, expected, 0.02);
+}
+
+/// A constant normal map tilts the shading normal by a known angle: under a directional
+/// light the floor's radiance is ρ/π · E · (n′·l) for the tilted n′. Tilting along the red
+/// channel turns the normal towards the tangent (+u); along green, towards the image's up
+/// (−v in glTF's downward-v texture space).
+#[test]
+fn a_constant_normal_map_tilts_the_shading_normal() {
+    let albedo = 0.5f32;
+    let irradiance = Vec3::splat(2.0);
+    let tilt = 30f32.to_radians();
+    // (tangent-space normal, direction the light travels): each case lit at 15° off n′.
+    let cases = [
+        (
+            Vec3::new(tilt.sin(), 0.0, tilt.cos()),
+            Vec3::new(-1.0, -1.0, 0.0),
+        ),
+        (
+            Vec3::new(0.0, tilt.sin(), tilt.cos()),
+            Vec3::new(0.0, -1.0, 1.0),
+        ),
+    ];
+    for (mapped, travel) in cases {
+        let mut b = SceneBuilder::new();
+        let floor = b.add_material(Material::diffuse("floor", Vec3::splat(albedo)));
+        let v = Vec3::new;
+        let mesh = b.add_mesh(
+            "floor",
+            vec![
+                v(-5., 0., -5.),
+                v(-5., 0., 5.),
+                v(5., 0., 5.),
+                v(5., 0., -5.),
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+            floor,
+        );
+        b.add_instance(mesh, Affine3A::IDENTITY, "floor");
+        b.add_light(Light {
+            name: "sun".into(),
+            kind: LightKind::Directional {
+                direction: travel.normalize(),
+                irradiance,
+            },
+            source: "test".into(),
+        });
+        let encoded = (0.5 * mapped + Vec3::splat(0.5)) * 65535.0;
+        let texture = b.add_texture(Texture {
+            name: "tilt".into(),
+            width: 1,
+            height: 1,
+            texels: vec![[
+                encoded.x.round() as u16,
+                encoded.y.round() as u16,
+                encoded.z.round() as u16,
+                65535,
+            ]],
+        });
+        let mut scene = b.build();
+        scene.materials[floor].textures.normal = Some(TextureRef::new(texture));
+        scene.materials[floor].textures.normal_scale = 1.0;
+        // u along +X, v along +Z (down the image), so the image's up is −Z; the floor faces +Y.
+        let m = &mut scene.meshes[mesh];
+        m.uvs = vec![
+            m.positions
+                .iter()
+                .map(|p| glam::Vec2::new(p.x, p.z))
+                .collect(),
+        ];
+        m.tangents = vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
+        // The world normal: T = +X, B = w·N×T = −Z, N = +Y.
+        let n = (mapped.x * Vec3::X + mapped.y * Vec3::NEG_Z + mapped.z * Vec3::Y).normalize();
+        let l = -travel.normalize();
+        let expected = (irradiance * albedo / std::f32::consts::PI * n.dot(l)).as_dvec3();
+        let target = v(0.2, 0.0, 0.1);
+        let ray = Ray::new(target + v(0.3, 2.0, 0.4), v(-0.3, -2.0, -0.4));
+        let (mean, _) = estimate(&scene, ray, Strategy::Mis, 16);
+        assert!(
+            (mean / expected - 1.0).abs().max_element() < 1e-3,
+            "tilt {mapped}: {mean} vs {expected} (unmapped would be {})",
+            expected * (Vec3::Y.dot(l) / n.dot(l)) as f64
         );
     }
 }

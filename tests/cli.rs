@@ -280,3 +280,45 @@ fn ctrl_c_stops_after_the_current_pass_and_writes_the_image_so_far() {
     assert!((1..1_000_000).contains(&spp), "spp {spp}");
     assert!(err.contains(&format!("stopped after {spp} of")), "{err}");
 }
+
+#[test]
+fn inspect_lists_what_was_loaded_and_renders_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/punctual_lights.glb");
+    let out = gridtrace(&["--inspect", &scene.display().to_string()], dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report = String::from_utf8_lossy(&out.stdout);
+    for expected in [
+        "meshes: 6 (2228 triangles)",
+        "'Panel': diffuse, albedo (0.000, 0.000, 0.000); area light, radiance (1.800, 6.000, 2.400)",
+        "one-sided",
+        // 60 W at colour (1, 0.8, 0.6): 60 × 0.8 = 48 W on average over the channels.
+        "'Point' (node 6 'Point'): point at (0.900, 1.600, 0.600)",
+        "48.00 W",
+        "directional towards",
+        "cameras: 1",
+        "vertical field of view 45.0°",
+        "warnings: 0",
+    ] {
+        assert!(
+            report.contains(expected),
+            "missing {expected:?} in:\n{report}"
+        );
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "nothing written"
+    );
+
+    // Warnings are part of the report.
+    let mut doc = common::quad_document();
+    doc["extensionsUsed"] = serde_json::json!(["EXT_unknown"]);
+    let path = common::write_gltf(dir.path(), "w.gltf", &doc);
+    let out = gridtrace(&["--inspect", &path.display().to_string()], dir.path());
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        report.contains("warnings: 1") && report.contains("EXT_unknown"),
+        "{report}"
+    );
+}

@@ -324,3 +324,12 @@ fn error_falls_as_one_over_root_spp() {
 fn blender_punctual_lights_match_cycles() {
     check_scene("punctual_lights", 512);
 }
+
+/// Blender's export of textures wired the usual ways: a checker through a Mapping node
+/// (KHR_texture_transform), a normal map without tangents (MikkTSpace), an emissive texture,
+/// an alpha cutout, and a textured box mirrored by a negative scale.
+#[test]
+fn blender_textures_match_cycles() {
+    check_scene("textured", 512);
+}
+

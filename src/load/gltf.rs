@@ -118,6 +118,14 @@ pub fn load_bytes_with(
     })
 }
 
+/// `KHR_texture_transform`'s T · R · S. The rotation turns UVs clockwise in (u, v), i.e.
+/// uv' = (u·cos + v·sin, −u·sin + v·cos): the extension's example (offset (0, 1), rotation
+/// π/2, scale ½ picks the lower-left quadrant) needs that sign, and Cycles renders Blender's
+/// exports with it (tests/reference_images.rs).
+pub fn texture_transform(offset: Vec2, rotation: f32, scale: Vec2) -> Affine2 {
+    Affine2::from_scale_angle_translation(scale, -rotation, offset)
+}
+
 /// The GLB container's 12-byte header (glTF 2.0 §4.4.2), checked before parsing so a
 /// wrong or truncated file gets a precise message.
 fn check_glb_header(bytes: &[u8], path: &Path) -> Result<(), String> {
@@ -282,9 +290,29 @@ impl GltfLoader {
                 )
             }),
             metallic_factor: pbr.metallic_factor(),
-            normal: material
-                .normal_texture()
-                .and_then(|info| self.texture_ref(&info.texture(), info.tex_coord(), None, &name)),
+            normal: material.normal_texture().and_then(|info| {
+                let mut r = self.texture_ref(&info.texture(), info.tex_coord(), None, &name)?;
+                // The gltf crate exposes KHR_texture_transform on normal textures only as JSON.
+                if let Some(t) = info.extension_value("KHR_texture_transform") {
+                    let pair = |key: &str, default: f32| {
+                        let v = &t[key];
+                        Vec2::new(
+                            v[0].as_f64().map_or(default, |x| x as f32),
+                            v[1].as_f64().map_or(default, |x| x as f32),
+                        )
+                    };
+                    let rotation = t["rotation"].as_f64().unwrap_or(0.0) as f32;
+                    r.transform =
+                        texture_transform(pair("offset", 0.0), rotation, pair("scale", 1.0));
+                    if let Some(set) = t["texCoord"]
+                        .as_u64()
+                        .filter(|&s| (s as usize) < MAX_UV_SETS)
+                    {
+                        r.texcoord = set as usize;
+                    }
+                }
+                Some(r)
+            }),
             normal_scale: material.normal_texture().map_or(1.0, |n| n.scale()),
         };
         let roughness = pbr.roughness_factor();
@@ -361,13 +389,8 @@ impl GltfLoader {
             Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
             _ => Filter::Linear,
         };
-        // T · R · S as KHR_texture_transform defines it.
         let transform = transform.map_or(Affine2::IDENTITY, |t| {
-            Affine2::from_scale_angle_translation(
-                Vec2::from(t.scale()),
-                t.rotation(),
-                Vec2::from(t.offset()),
-            )
+            texture_transform(Vec2::from(t.offset()), t.rotation(), Vec2::from(t.scale()))
         });
         Some(TextureRef {
             texture: image,

@@ -100,7 +100,10 @@ impl mikktspace::Geometry for Corners<'_> {
     }
 
     fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
-        self.tangents[3 * face + vert] = Vec4::from(tangent);
+        // MikkTSpace's bitangent follows increasing v, which in glTF runs down the image;
+        // a glTF normal map's +Y (green) points up the image, so the sign flips.
+        let [x, y, z, w] = tangent;
+        self.tangents[3 * face + vert] = Vec4::new(x, y, z, -w);
     }
 }
 
@@ -109,7 +112,8 @@ mod tests {
     use super::*;
 
     /// A quad in the XY plane facing +Z with u along +X and v along −Y (glTF's v points down
-    /// the image): the tangent must be +X and the bitangent, sign × N × T, must follow +v.
+    /// the image): the tangent must be +X and the bitangent, sign × N × T, must point up the
+    /// image (−v), where a glTF normal map's green axis points.
     #[test]
     fn tangents_follow_the_texture_axes() {
         let mut mesh = Mesh {
@@ -134,9 +138,9 @@ mod tests {
         assert_eq!(mesh.positions.len(), 6);
         for t in &mesh.tangents {
             assert!((t.truncate() - Vec3::X).length() < 1e-5, "{t}");
-            // Bitangent points where v grows: −Y here.
+            // Up the image, where v shrinks: +Y here.
             let bitangent = t.w * Vec3::Z.cross(t.truncate());
-            assert!((bitangent - Vec3::NEG_Y).length() < 1e-5, "{bitangent}");
+            assert!((bitangent - Vec3::Y).length() < 1e-5, "{bitangent}");
         }
     }
 }

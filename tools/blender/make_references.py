@@ -157,7 +157,10 @@ def textured(name, image, link_to="Base Color", colour=(1.0, 1.0, 1.0), mapping=
     bsdf = nodes["Principled BSDF"]
     tex = nodes.new("ShaderNodeTexImage")
     tex.image = image
-    tex.interpolation = "Linear"
+    # Closest (glTF magFilter NEAREST): Cycles filters 8-bit sRGB images before decoding them,
+    # gridtrace (like GPUs and the glTF specification) decodes first, so bilinear edges would
+    # differ by design, not by error. Bilinear filtering has its own unit tests.
+    tex.interpolation = "Closest"
     tex.extension = "REPEAT"
     if mapping is not None:
         coords = nodes.new("ShaderNodeTexCoord")
@@ -195,10 +198,11 @@ def build_textured(scene):
         return (0.85, 0.8, 0.7, 1.0) if odd else (0.6, 0.2, 0.1, 1.0)
 
     def bumps(u, v):
-        # Height h = sin(2π·4u)·sin(2π·4v)/8; normal (−∂h/∂u, −∂h/∂v, 1) in tangent space.
+        # Height h = sin(2π·4u)·sin(2π·4v)/160; normal (−∂h/∂u, −∂h/∂v, 1) in tangent space,
+        # tilted by at most 9°.
         k = 2 * math.pi * 4
-        dx = k * math.cos(k * u) * math.sin(k * v) / 8 * 0.15
-        dy = k * math.sin(k * u) * math.cos(k * v) / 8 * 0.15
+        dx = k * math.cos(k * u) * math.sin(k * v) / 8 * 0.05
+        dy = k * math.sin(k * u) * math.cos(k * v) / 8 * 0.05
         n = (-dx, -dy, 1.0)
         length = math.sqrt(sum(c * c for c in n))
         return tuple(0.5 + 0.5 * c / length for c in n) + (1.0,)
@@ -221,6 +225,10 @@ def build_textured(scene):
     bumpy = textured("Bumpy", make_image("bumps", 64, bumps, "Non-Color"), colour=(0.8, 0.8, 0.8),
                      normal_strength=1.0)
     glow = textured("Glow", make_image("gradient", 32, gradient), colour=(0.0, 0.0, 0.0), emission_strength=4.0)
+    # One-sided, as the other lights here: lit from behind, the 5 cm gap to the wall would be a
+    # hidden hot spot that paths find only by chance (a heavy tail that no finite render gets
+    # right).
+    glow.use_backface_culling = True
     leafy = textured("Leaf", make_image("leaf", 64, leaf), cutout=True)
     marked = textured("Marked", make_image("arrow", 32, arrow))
     light = principled("Light", (0.0, 0.0, 0.0), emission=(1.0, 0.95, 0.85), strength=6.0)

@@ -1,0 +1,209 @@
+//! `gridtrace --inspect`: a plain-text account of what a loader made of a file, so a user can
+//! see how each material was mapped, how strong each light is and what was skipped.
+
+use std::f32::consts::PI;
+use std::fmt::Write;
+
+use glam::Vec3;
+
+use crate::scene::{AlphaMode, LightKind, Material, MaterialKind, Projection, Scene};
+
+/// The report: meshes, instances, materials with their class, textures, lights with their
+/// power, cameras and every warning.
+pub fn describe(scene: &Scene, warnings: &[String]) -> String {
+    let mut out = String::new();
+    let triangles: usize = scene.meshes.iter().map(|m| m.indices.len()).sum();
+    let bounds = scene.bounds();
+    let _ = writeln!(
+        out,
+        "meshes: {} ({triangles} triangles); instances: {} ({} triangles after instancing)",
+        scene.meshes.len(),
+        scene.instances.len(),
+        scene.instanced_triangle_count()
+    );
+    if !bounds.is_empty() {
+        let _ = writeln!(
+            out,
+            "bounds: {} to {}",
+            vector(bounds.min),
+            vector(bounds.max)
+        );
+    }
+    let emitted = emitted_power(scene);
+    let _ = writeln!(out, "materials: {}", scene.materials.len());
+    for (i, m) in scene.materials.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "  {i} '{}': {}",
+            m.name,
+            material_summary(m, emitted[i])
+        );
+    }
+    let _ = writeln!(out, "textures: {}", scene.textures.len());
+    for (i, t) in scene.textures.iter().enumerate() {
+        let _ = writeln!(out, "  {i} {}: {}x{}", t.name, t.width, t.height);
+    }
+    let _ = writeln!(out, "lights: {}", scene.lights.len());
+    for light in &scene.lights {
+        let _ = writeln!(
+            out,
+            "  '{}' ({}): {}",
+            light.name,
+            light.source,
+            light_summary(&light.kind)
+        );
+    }
+    let _ = writeln!(out, "cameras: {}", scene.cameras.len());
+    for (i, c) in scene.cameras.iter().enumerate() {
+        let position = c.world_from_camera.transform_point3(Vec3::ZERO);
+        let projection = match c.projection {
+            Projection::Perspective { yfov, .. } => {
+                format!(
+                    "perspective, vertical field of view {:.1}°",
+                    yfov.to_degrees()
+                )
+            }
+            Projection::Orthographic { xmag, ymag } => {
+                format!("orthographic, {xmag} x {ymag}")
+            }
+        };
+        let _ = writeln!(
+            out,
+            "  {i} '{}' ({}): {projection}, at {}, near {}",
+            c.name,
+            c.source,
+            vector(position),
+            c.znear
+        );
+    }
+    let _ = writeln!(out, "warnings: {}", warnings.len());
+    for w in warnings {
+        let _ = writeln!(out, "  {w}");
+    }
+    out
+}
+
+fn vector(v: Vec3) -> String {
+    format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z)
+}
+
+fn material_summary(m: &Material, emitted: f32) -> String {
+    let mut s = match m.kind {
+        MaterialKind::Diffuse { albedo } => format!("diffuse, albedo {}", vector(albedo)),
+        MaterialKind::Mirror { reflectance } => {
+            format!("mirror, reflectance {}", vector(reflectance))
+        }
+        MaterialKind::Glass { ior, tint } => format!("glass, ior {ior}, tint {}", vector(tint)),
+    };
+    if m.is_emissive() {
+        let _ = write!(
+            s,
+            "; area light, radiance {}, {} W emitted",
+            vector(m.emission),
+            significant(emitted)
+        );
+    }
+    if !m.double_sided {
+        s.push_str("; one-sided");
+    }
+    let t = &m.textures;
+    let textures: Vec<&str> = [
+        (t.base_colour.is_some(), "base colour"),
+        (t.emissive.is_some(), "emission"),
+        (t.metallic_roughness.is_some(), "metallic"),
+        (t.normal.is_some(), "normal map"),
+    ]
+    .into_iter()
+    .filter_map(|(used, name)| used.then_some(name))
+    .collect();
+    if !textures.is_empty() {
+        let _ = write!(s, "; textures: {}", textures.join(", "));
+    }
+    match m.alpha_mode {
+        AlphaMode::Opaque => {}
+        AlphaMode::Mask { cutoff } => {
+            let _ = write!(s, "; alpha cutout at {cutoff}");
+        }
+        AlphaMode::Blend => s.push_str("; alpha blended"),
+    }
+    if m.absorption != Vec3::ZERO {
+        let _ = write!(s, "; absorption {} per unit", vector(m.absorption));
+    }
+    s
+}
+
+/// Power (W, mean over channels) each material emits over all its instances, with constant
+/// emission (textures not counted).
+fn emitted_power(scene: &Scene) -> Vec<f32> {
+    let mut power = vec![0.0f32; scene.materials.len()];
+    for inst in &scene.instances {
+        let mesh = &scene.meshes[inst.mesh];
+        let material = &scene.materials[mesh.material];
+        if !material.is_emissive() {
+            continue;
+        }
+        let area: f32 = mesh
+            .indices
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| {
+                    inst.world_from_object
+                        .transform_point3(mesh.positions[i as usize])
+                });
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .filter(|a| a.is_finite())
+            .sum();
+        let sides = if material.double_sided { 2.0 } else { 1.0 };
+        power[mesh.material] += sides * PI * area * material.emission.element_sum() / 3.0;
+    }
+    power
+}
+
+fn light_summary(kind: &LightKind) -> String {
+    match *kind {
+        LightKind::Point {
+            position,
+            intensity,
+            range,
+        } => format!(
+            "point at {}, intensity {} W/sr, {} W{}",
+            vector(position),
+            vector(intensity),
+            significant(4.0 * PI * intensity.element_sum() / 3.0),
+            range.map_or(String::new(), |r| format!(", range {r}"))
+        ),
+        LightKind::Spot {
+            position,
+            direction,
+            intensity,
+            cos_inner,
+            cos_outer,
+            ..
+        } => format!(
+            "spot at {} towards {}, intensity {} W/sr, cone {:.1}° to {:.1}°",
+            vector(position),
+            vector(direction),
+            vector(intensity),
+            cos_inner.acos().to_degrees(),
+            cos_outer.acos().to_degrees()
+        ),
+        LightKind::Directional {
+            direction,
+            irradiance,
+        } => format!(
+            "directional towards {}, irradiance {} W/m²",
+            vector(direction),
+            vector(irradiance)
+        ),
+    }
+}
+
+/// Four significant digits.
+fn significant(v: f32) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = (3 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
+}
