@@ -209,3 +209,67 @@ fn texture_transform_follows_the_extensions_example() {
         );
     }
 }
+
+/// Blender's export of a glass with a Volume Absorption node (colour (0.9, 0.5, 0.2),
+/// density 2 → attenuationDistance 0.5) and of a rough metal.
+#[test]
+fn blender_volume_glass_and_rough_metal() {
+    let loaded = load_scene(std::path::Path::new("tests/scenes/material_details.glb")).unwrap();
+    let materials = &loaded.scene.materials;
+    let glass = materials.iter().find(|m| m.name == "TintedGlass").unwrap();
+    assert!(matches!(glass.kind, MaterialKind::Glass { ior, .. } if ior == 1.5));
+    // Blender writes doubleSided: false with the volume; glass is two-sided regardless.
+    assert!(glass.double_sided);
+    let expected = Vec3::new(0.9f32.ln(), 0.5f32.ln(), 0.2f32.ln()) / -0.5;
+    assert!(
+        (glass.absorption - expected).abs().max_element() < 1e-5,
+        "{}",
+        glass.absorption
+    );
+    let metal = materials.iter().find(|m| m.name == "RoughMetal").unwrap();
+    assert!(matches!(metal.kind, MaterialKind::Mirror { .. }));
+    assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+    assert!(loaded.warnings[0].contains("'RoughMetal': roughness 0.4"));
+}
+
+/// `COLOR_0` is read and switches the material's vertex colours on; `TEXCOORD_1` is kept as
+/// the second set.
+#[test]
+fn vertex_colours_and_a_second_uv_set_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    write_uvs(dir.path());
+    let colours: [f32; 16] = [
+        1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.5, 1.0, 1.0, 1.0, 0.25,
+    ];
+    let bytes: Vec<u8> = colours.iter().flat_map(|f| f.to_le_bytes()).collect();
+    std::fs::write(dir.path().join("colour.bin"), bytes).unwrap();
+    let mut doc = textured_document(
+        json!([]),
+        json!([{"name": "painted", "pbrMetallicRoughness": {"metallicFactor": 0.0}}]),
+    );
+    doc.as_object_mut().unwrap().remove("images");
+    doc.as_object_mut().unwrap().remove("textures");
+    doc["buffers"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"uri": "colour.bin", "byteLength": 64}));
+    doc["bufferViews"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"buffer": 2, "byteOffset": 0, "byteLength": 64}));
+    doc["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC4"}));
+    doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = json!(3);
+    doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = json!(2);
+    let loaded = load_scene(&write_gltf(dir.path(), "c.gltf", &doc)).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let scene = &loaded.scene;
+    assert!(scene.materials[0].vertex_colours);
+    let mesh = &scene.meshes[0];
+    assert_eq!(mesh.colours.len(), 4);
+    assert_eq!(mesh.colours[2], glam::Vec4::new(0.0, 0.0, 1.0, 0.5));
+    assert_eq!(mesh.uvs.len(), 2);
+    assert_eq!(mesh.uvs[1], mesh.uvs[0]);
+}

@@ -332,4 +332,3 @@ fn blender_punctual_lights_match_cycles() {
 fn blender_textures_match_cycles() {
     check_scene("textured", 512);
 }
-

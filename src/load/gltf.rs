@@ -344,11 +344,15 @@ impl GltfLoader {
                 Vec3::ZERO
             }
         });
+        // A glass object's back faces are the inside of its volume, which rays leaving it
+        // must cross: glass is always two-sided (Blender writes doubleSided: false with
+        // KHR_materials_volume).
+        let double_sided = material.double_sided() || matches!(kind, MaterialKind::Glass { .. });
         Material {
             name,
             kind,
             emission,
-            double_sided: material.double_sided(),
+            double_sided,
             textures,
             vertex_colours: false,
             alpha,

@@ -21,7 +21,7 @@ import bpy
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SCENES = ["cornell_box", "cornell_spheres", "caustic", "coloured_lights", "punctual_lights"]
+SCENES = ["cornell_box", "cornell_spheres", "caustic", "coloured_lights", "punctual_lights", "textured"]
 SIZE = 128
 GAP = 4
 DIFFERENCE_SCALE = 4.0

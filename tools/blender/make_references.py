@@ -258,7 +258,29 @@ def build_textured(scene):
     add_camera(scene, (0.3, -5.0, 2.4), (0.3, 0.0, 0.6), 45.0)
 
 
-# name -> (builder, directory of the exported .glb, total reference samples)
+def build_material_details(scene):
+    """Materials the loader must read but Cycles cannot check here: a glass whose volume
+    absorbs (Blender exports KHR_materials_volume only through a "glTF Material Output" group
+    with a Thickness input, and Cycles' Volume Absorption, σ = density·(1 − colour), is not
+    glTF's σ = −ln(colour)/distance), and a rough metal, which gridtrace renders ideal."""
+    glass = principled("TintedGlass", (1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5)
+    nodes, links = glass.node_tree.nodes, glass.node_tree.links
+    out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
+    absorption = nodes.new("ShaderNodeVolumeAbsorption")
+    absorption.inputs["Color"].default_value = (0.9, 0.5, 0.2, 1.0)
+    absorption.inputs["Density"].default_value = 2.0
+    links.new(absorption.outputs["Volume"], out.inputs["Volume"])
+    group = bpy.data.node_groups.new("glTF Material Output", "ShaderNodeTree")
+    group.interface.new_socket("Thickness", in_out="INPUT", socket_type="NodeSocketFloat")
+    settings = nodes.new("ShaderNodeGroup")
+    settings.node_tree = group
+    settings.inputs["Thickness"].default_value = 1.0
+    rough = principled("RoughMetal", (0.9, 0.9, 0.9), metallic=1.0, roughness=0.4)
+    sphere("GlassBall", glass, 0.5, (0.0, 0.0, 0.5))
+    sphere("MetalBall", rough, 0.5, (1.5, 0.0, 0.5))
+
+
+# name -> (builder, directory of the exported .glb, total reference samples; 0: export only)
 SCENE_TABLE = {
     "cornell_box": (build_cornell_box, os.path.join(ROOT, "assets"), 8192),
     "cornell_spheres": (build_cornell_spheres, os.path.join(ROOT, "assets"), 8192),
@@ -266,6 +288,7 @@ SCENE_TABLE = {
     "coloured_lights": (build_coloured_lights, SCENES, 4096),
     "punctual_lights": (build_punctual_lights, SCENES, 4096),
     "textured": (build_textured, SCENES, 4096),
+    "material_details": (build_material_details, SCENES, 0),
 }
 
 
@@ -425,6 +448,8 @@ def main():
         for mat in bpy.data.materials:
             if mat.node_tree and mat.node_tree.nodes.get("Principled BSDF"):
                 use_exact_models(mat)
+        if samples == 0:
+            continue
         for half, seed in (("a", 1), ("b", 2)):
             render(scene, os.path.join(REFERENCES, f"{name}_{half}.exr"), samples // 2, seed)
     return 0
