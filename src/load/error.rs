@@ -14,7 +14,9 @@ pub enum LoadError {
         source: std::io::Error,
     },
     /// The extension names no format we read.
-    #[error("{path}: unknown scene format (expected .gltf, .glb, .ply or .ply.gz)")]
+    #[error(
+        "{path}: unknown scene format (expected .gltf, .glb, .usd, .usda, .usdc, .usdz, .ply or .ply.gz)"
+    )]
     UnknownFormat {
         /// The scene file.
         path: PathBuf,

@@ -5,6 +5,7 @@ pub mod gltf;
 mod images;
 pub mod ply;
 mod tangents;
+pub mod usd;
 
 pub use error::LoadError;
 
@@ -90,6 +91,12 @@ fn load_by_format(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadErro
         .unwrap_or_default();
     if name.ends_with(".gltf") || name.ends_with(".glb") {
         gltf::load_with(path, options)
+    } else if name.ends_with(".usd")
+        || name.ends_with(".usda")
+        || name.ends_with(".usdc")
+        || name.ends_with(".usdz")
+    {
+        usd::load(path)
     } else if name.ends_with(".ply") || name.ends_with(".ply.gz") {
         ply::load(path)
     } else {

@@ -5,8 +5,8 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
     pip install bpy==5.0.1
     python3 tools/blender/make_cornell.py
 
-Writes `assets/cornell_box.glb` (two diffuse boxes) and `assets/cornell_spheres.glb`
-(a mirror sphere and a glass sphere). Blender is Z-up; the exporter converts to glTF's Y-up.
+Writes `assets/cornell_box.glb` (two diffuse boxes, also as `assets/cornell_box.usdc` through
+Blender's USD exporter) and `assets/cornell_spheres.glb` (a mirror sphere and a glass sphere). Blender is Z-up; the exporter converts to glTF's Y-up.
 The wall colours are the usual Cornell box reflectances; the light is an emissive quad that
 fills an opening in the ceiling, exported through KHR_materials_emissive_strength.
 """
@@ -156,6 +156,13 @@ def main():
     for name, build in (("cornell_box", build_cornell_box), ("cornell_spheres", build_cornell_spheres)):
         build(reset())
         export(os.path.join(ASSETS, f"{name}.glb"))
+        if name == "cornell_box":
+            # The same scene through Blender's USD exporter (Z-up, metres). The spheres scene
+            # is not exported: Blender's USD exporter writes no transmission, so its glass
+            # would arrive opaque.
+            path = os.path.join(ASSETS, f"{name}.usdc")
+            bpy.ops.wm.usd_export(filepath=path)
+            print(f"wrote {path} ({os.path.getsize(path)} bytes)")
     return 0
 
 

@@ -1,0 +1,969 @@
+//! USD (`.usda`, `.usdc`, `.usdz`) through the pure-Rust `openusd` crate: the composed stage
+//! (references, payloads, variants as the crate composes them) is walked from its root
+//! prims, and every renderable prim becomes scene data, named by its prim path.
+//!
+//! Units and axes: the stage's `upAxis` Z is turned to gridtrace's (and glTF's) Y-up with
+//! (x, y, z) → (x, z, −y), and `metersPerUnit` scales to metres, so a Blender scene arrives
+//! exactly as its glTF export does. Material mapping follows the glTF table (README):
+//! `UsdPreviewSurface` `emissiveColor` → area light, `metallic` ≥ 0.5 → mirror, `opacity` <
+//! 0.5 → glass with `ior`, else Lambertian `diffuseColor`.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use glam::{Affine3A, Mat4, Vec2, Vec3};
+use openusd::{sdf, usd};
+
+use super::{LoadError, Loaded};
+use crate::scene::{
+    Camera, Light, LightKind, Material, MaterialKind, Mesh, Projection, SceneBuilder,
+};
+
+/// Deepest prim hierarchy walked.
+const MAX_DEPTH: usize = 256;
+
+/// Segments of the polygon a `DiskLight` becomes.
+const DISK_SEGMENTS: u32 = 48;
+
+/// Loads a USD stage.
+pub fn load(path: &Path) -> Result<Loaded, LoadError> {
+    let invalid = |what: String| LoadError::Invalid {
+        path: path.to_path_buf(),
+        what,
+    };
+    let name = path
+        .to_str()
+        .ok_or_else(|| invalid("the path is not valid UTF-8".into()))?;
+    if !path.is_file() {
+        return Err(LoadError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        });
+    }
+    let stage =
+        usd::Stage::open(name).map_err(|e| invalid(format!("cannot open USD stage: {e:#}")))?;
+    let mut loader = UsdLoader {
+        path: path.to_path_buf(),
+        stage,
+        builder: SceneBuilder::new(),
+        materials: HashMap::new(),
+        default_material: None,
+        one_sided: HashMap::new(),
+        warnings: Vec::new(),
+    };
+    let root = loader.stage_correction();
+    let roots = loader
+        .stage
+        .root_prims()
+        .map_err(|e| invalid(format!("cannot list root prims: {e:#}")))?;
+    for prim_name in roots {
+        let prim = loader
+            .stage
+            .prim(format!("/{}", prim_name.as_str()).as_str());
+        loader.visit(&prim, root, 0)?;
+    }
+    Ok(Loaded {
+        scene: loader.builder.build(),
+        warnings: loader.warnings,
+    })
+}
+
+struct UsdLoader {
+    path: PathBuf,
+    stage: usd::Stage,
+    builder: SceneBuilder,
+    /// Our material index for each bound USD material prim path.
+    materials: HashMap<String, usize>,
+    default_material: Option<usize>,
+    /// One-sided copies of materials, by the original's index.
+    one_sided: HashMap<usize, usize>,
+    warnings: Vec<String>,
+}
+
+/// Any prim seen through the `Xformable` schema, whose `xformOpOrder` composition the crate
+/// implements; a prim without ops gives the identity.
+struct AnyXformable(usd::Prim);
+
+impl usd::SchemaBase for AnyXformable {
+    const KIND: usd::SchemaKind = usd::SchemaKind::ConcreteTyped;
+
+    fn prim(&self) -> &usd::Prim {
+        &self.0
+    }
+}
+
+impl openusd::schemas::geom::Imageable for AnyXformable {}
+
+impl openusd::schemas::geom::Xformable for AnyXformable {}
+
+/// A value read from the stage, whatever its precision.
+fn value(stage: &usd::Stage, prim: &sdf::Path, name: &str) -> Option<sdf::Value> {
+    let path = prim.append_property(name).ok()?;
+    stage.attribute(path).get::<sdf::Value>().ok().flatten()
+}
+
+fn as_f64(v: &sdf::Value) -> Option<f64> {
+    match v {
+        sdf::Value::Double(d) => Some(*d),
+        sdf::Value::Float(f) => Some(*f as f64),
+        sdf::Value::Half(h) => Some(h.to_f32() as f64),
+        sdf::Value::Int(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+fn as_vec3(v: &sdf::Value) -> Option<Vec3> {
+    match v {
+        sdf::Value::Vec3f(a) => Some(Vec3::new(a.x, a.y, a.z)),
+        sdf::Value::Vec3d(a) => Some(Vec3::new(a.x as f32, a.y as f32, a.z as f32)),
+        sdf::Value::Vec3h(a) => Some(Vec3::new(a.x.to_f32(), a.y.to_f32(), a.z.to_f32())),
+        _ => None,
+    }
+}
+
+fn as_vec3s(v: &sdf::Value) -> Option<Vec<Vec3>> {
+    match v {
+        sdf::Value::Vec3fVec(a) => Some(a.iter().map(|a| Vec3::new(a.x, a.y, a.z)).collect()),
+        sdf::Value::Vec3dVec(a) => Some(
+            a.iter()
+                .map(|a| Vec3::new(a.x as f32, a.y as f32, a.z as f32))
+                .collect(),
+        ),
+        sdf::Value::Vec3hVec(a) => Some(
+            a.iter()
+                .map(|a| Vec3::new(a.x.to_f32(), a.y.to_f32(), a.z.to_f32()))
+                .collect(),
+        ),
+        _ => None,
+    }
+}
+
+fn as_vec2s(v: &sdf::Value) -> Option<Vec<Vec2>> {
+    match v {
+        sdf::Value::Vec2fVec(a) => Some(a.iter().map(|a| Vec2::new(a.x, a.y)).collect()),
+        sdf::Value::Vec2dVec(a) => Some(
+            a.iter()
+                .map(|a| Vec2::new(a.x as f32, a.y as f32))
+                .collect(),
+        ),
+        _ => None,
+    }
+}
+
+fn as_ints(v: &sdf::Value) -> Option<Vec<i64>> {
+    match v {
+        sdf::Value::IntVec(a) => Some(a.iter().map(|&i| i as i64).collect()),
+        sdf::Value::Int64Vec(a) => Some(a.clone()),
+        sdf::Value::UintVec(a) => Some(a.iter().map(|&i| i as i64).collect()),
+        _ => None,
+    }
+}
+
+fn as_token(v: &sdf::Value) -> Option<String> {
+    match v {
+        sdf::Value::Token(t) => Some(t.as_str().to_string()),
+        sdf::Value::String(s) => Some(s.clone()),
+        _ => None,
+    }
+}
+
+fn as_bool(v: &sdf::Value) -> Option<bool> {
+    match v {
+        sdf::Value::Bool(b) => Some(*b),
+        sdf::Value::Int(i) => Some(*i != 0),
+        _ => None,
+    }
+}
+
+/// How a primvar's values map onto a mesh (UsdGeom primvar interpolation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Interpolation {
+    /// One value for the whole mesh.
+    Constant,
+    /// One value per face.
+    Uniform,
+    /// One value per point.
+    Vertex,
+    /// One value per face corner.
+    FaceVarying,
+}
+
+impl UsdLoader {
+    fn warn(&mut self, what: String) {
+        self.warnings
+            .push(format!("{}: {what}", self.path.display()));
+    }
+
+    fn invalid(&self, what: String) -> LoadError {
+        LoadError::Invalid {
+            path: self.path.clone(),
+            what,
+        }
+    }
+
+    fn get(&self, prim: &sdf::Path, name: &str) -> Option<sdf::Value> {
+        value(&self.stage, prim, name)
+    }
+
+    fn get_f32(&self, prim: &sdf::Path, name: &str) -> Option<f32> {
+        self.get(prim, name)
+            .as_ref()
+            .and_then(as_f64)
+            .map(|v| v as f32)
+    }
+
+    fn get_token(&self, prim: &sdf::Path, name: &str) -> Option<String> {
+        self.get(prim, name).as_ref().and_then(as_token)
+    }
+
+    /// The transform from stage space to gridtrace's: Y up, metres.
+    fn stage_correction(&mut self) -> Mat4 {
+        let up = self
+            .stage
+            .stage_metadata("upAxis")
+            .ok()
+            .flatten()
+            .as_ref()
+            .and_then(as_token)
+            .unwrap_or_else(|| "Y".into());
+        let meters = self
+            .stage
+            .stage_metadata("metersPerUnit")
+            .ok()
+            .flatten()
+            .as_ref()
+            .and_then(as_f64)
+            .filter(|m| m.is_finite() && *m > 0.0)
+            .unwrap_or(0.01) as f32;
+        let axes = match up.as_str() {
+            "Z" => Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+            "Y" => Mat4::IDENTITY,
+            other => {
+                self.warn(format!("upAxis '{other}' is not Y or Z; treating it as Y"));
+                Mat4::IDENTITY
+            }
+        };
+        Mat4::from_scale(Vec3::splat(meters)) * axes
+    }
+
+    /// The prim's local-to-parent transform (its `xformOpOrder` stack), or `None` when the
+    /// stack resets the parent's.
+    fn local_transform(&mut self, prim: &usd::Prim) -> Result<(Mat4, bool), LoadError> {
+        use openusd::schemas::geom::Xformable;
+        let xform = AnyXformable(prim.clone());
+        let time = usd::TimeCode::new(self.stage.start_time_code());
+        let m = xform
+            .local_to_parent_transform(time)
+            .map_err(|e| self.invalid(format!("{}: {e:#}", prim.path().as_str())))?;
+        let resets = xform.resets_xform_stack().unwrap_or(false);
+        // USD's row-vector matrices, stored row by row, are glam's column-vector matrices
+        // stored column by column.
+        let local = Mat4::from_cols_array(&m.0.map(|v| v as f32));
+        Ok((local, resets))
+    }
+
+    fn visit(&mut self, prim: &usd::Prim, parent: Mat4, depth: usize) -> Result<(), LoadError> {
+        let path = prim.path().clone();
+        let where_ = path.as_str().to_string();
+        if depth > MAX_DEPTH {
+            return Err(self.invalid(format!("{where_}: prim hierarchy deeper than {MAX_DEPTH}")));
+        }
+        if !prim.is_active().unwrap_or(true) {
+            return Ok(());
+        }
+        if self.get_token(&path, "visibility").as_deref() == Some("invisible") {
+            return Ok(());
+        }
+        if matches!(
+            self.get_token(&path, "purpose").as_deref(),
+            Some("proxy" | "guide")
+        ) {
+            return Ok(());
+        }
+        let type_name = prim
+            .type_name()
+            .ok()
+            .flatten()
+            .map(|t| t.as_str().to_string())
+            .unwrap_or_default();
+        if matches!(
+            type_name.as_str(),
+            "Material" | "Shader" | "NodeGraph" | "GeomSubset"
+        ) {
+            return Ok(());
+        }
+        let (local, resets) = self.local_transform(prim)?;
+        let world = if resets {
+            self.stage_correction() * local
+        } else {
+            parent * local
+        };
+        if !world.is_finite() {
+            return Err(self.invalid(format!("{where_}: non-finite transform")));
+        }
+        match type_name.as_str() {
+            "Mesh" => self.add_mesh(prim, world)?,
+            "Camera" => self.add_camera(&path, world),
+            "RectLight" | "DiskLight" | "SphereLight" | "DistantLight" => {
+                self.add_light(&path, &type_name, world)
+            }
+            "DomeLight" => self.warn(format!(
+                "{where_}: DomeLight (environment lighting) is not supported yet; ignored"
+            )),
+            "" | "Xform" | "Scope" | "SkelRoot" => {}
+            "Sphere" | "Cube" | "Cylinder" | "Cone" | "Capsule" | "Plane" | "Points"
+            | "BasisCurves" | "NurbsCurves" | "NurbsPatch" | "PointInstancer" | "Volume" => self
+                .warn(format!(
+                    "{where_}: {type_name} prims are not supported; skipped"
+                )),
+            _ => {}
+        }
+        let children = prim
+            .children()
+            .map_err(|e| self.invalid(format!("{where_}: {e:#}")))?;
+        for child in children {
+            self.visit(&child, world, depth + 1)?;
+        }
+        Ok(())
+    }
+
+    /// A primvar (or the `normals` attribute) and its interpolation.
+    fn primvar<T>(
+        &self,
+        prim: &sdf::Path,
+        name: &str,
+        convert: impl Fn(&sdf::Value) -> Option<Vec<T>>,
+        default: Interpolation,
+    ) -> Option<(Vec<T>, Interpolation)>
+    where
+        T: Copy,
+    {
+        let attr_path = prim.append_property(name).ok()?;
+        let attribute = self.stage.attribute(attr_path);
+        let raw = attribute.get::<sdf::Value>().ok().flatten()?;
+        let mut values = convert(&raw)?;
+        // Indexed primvars: values[indices[i]].
+        if let Some(indices) = self
+            .get(prim, &format!("{name}:indices"))
+            .as_ref()
+            .and_then(as_ints)
+        {
+            let mut expanded = Vec::with_capacity(indices.len());
+            for i in indices {
+                expanded.push(*values.get(usize::try_from(i).ok()?)?);
+            }
+            values = expanded;
+        }
+        let interpolation = match attribute
+            .get_metadata::<sdf::Value>("interpolation")
+            .ok()
+            .flatten()
+            .as_ref()
+            .and_then(as_token)
+            .as_deref()
+        {
+            Some("constant") => Interpolation::Constant,
+            Some("uniform") => Interpolation::Uniform,
+            Some("vertex") | Some("varying") => Interpolation::Vertex,
+            Some("faceVarying") => Interpolation::FaceVarying,
+            _ => default,
+        };
+        Some((values, interpolation))
+    }
+
+    fn add_mesh(&mut self, prim: &usd::Prim, world: Mat4) -> Result<(), LoadError> {
+        let path = prim.path().clone();
+        let where_ = path.as_str().to_string();
+        let points = self
+            .get(&path, "points")
+            .as_ref()
+            .and_then(as_vec3s)
+            .unwrap_or_default();
+        let counts = self
+            .get(&path, "faceVertexCounts")
+            .as_ref()
+            .and_then(as_ints)
+            .unwrap_or_default();
+        let indices = self
+            .get(&path, "faceVertexIndices")
+            .as_ref()
+            .and_then(as_ints)
+            .unwrap_or_default();
+        if points.is_empty() || counts.is_empty() {
+            return Ok(());
+        }
+        if counts.iter().any(|&c| c < 0) || counts.iter().sum::<i64>() != indices.len() as i64 {
+            return Err(self.invalid(format!(
+                "{where_}: faceVertexCounts add up to {} but there are {} faceVertexIndices",
+                counts.iter().sum::<i64>(),
+                indices.len()
+            )));
+        }
+        if let Some(&bad) = indices
+            .iter()
+            .find(|&&i| i < 0 || i as usize >= points.len())
+        {
+            return Err(self.invalid(format!(
+                "{where_}: face vertex index {bad} is outside the {} points",
+                points.len()
+            )));
+        }
+        if let Some(scheme) = self.get_token(&path, "subdivisionScheme")
+            && scheme != "none"
+        {
+            self.warn(format!(
+                "{where_}: subdivisionScheme '{scheme}' is rendered as its control cage (no subdivision)"
+            ));
+        }
+        let left_handed = self.get_token(&path, "orientation").as_deref() == Some("leftHanded");
+        let double_sided = self
+            .get(&path, "doubleSided")
+            .as_ref()
+            .and_then(as_bool)
+            .unwrap_or(false);
+        let normals = self
+            .primvar(&path, "primvars:normals", as_vec3s, Interpolation::Vertex)
+            .or_else(|| self.primvar(&path, "normals", as_vec3s, Interpolation::Vertex));
+        let uvs = self.primvar(&path, "primvars:st", as_vec2s, Interpolation::FaceVarying);
+
+        // Each face's first corner (into faceVertexIndices) and corner count.
+        let mut face_start = Vec::with_capacity(counts.len());
+        let mut start = 0usize;
+        for &c in &counts {
+            face_start.push(start);
+            start += c as usize;
+        }
+        // Which material each face uses: GeomSubsets of the materialBind family override the
+        // mesh's own binding.
+        let mesh_material = self.bound_material(&path);
+        let mut face_material = vec![mesh_material; counts.len()];
+        for child in prim
+            .children()
+            .map_err(|e| self.invalid(format!("{where_}: {e:#}")))?
+        {
+            let child_path = child.path().clone();
+            let is_subset = child
+                .type_name()
+                .ok()
+                .flatten()
+                .is_some_and(|t| t.as_str() == "GeomSubset");
+            if !is_subset
+                || self.get_token(&child_path, "familyName").as_deref() != Some("materialBind")
+            {
+                continue;
+            }
+            let material = self.bound_material(&child_path);
+            for face in self
+                .get(&child_path, "indices")
+                .as_ref()
+                .and_then(as_ints)
+                .unwrap_or_default()
+            {
+                if let Some(slot) = usize::try_from(face)
+                    .ok()
+                    .and_then(|f| face_material.get_mut(f))
+                {
+                    *slot = material;
+                }
+            }
+        }
+
+        // Triangulate each face into corners (indices into faceVertexIndices).
+        let mut by_material: HashMap<usize, Vec<[usize; 3]>> = HashMap::new();
+        for (face, &count) in counts.iter().enumerate() {
+            let first = face_start[face];
+            let corners: Vec<usize> = (first..first + count as usize).collect();
+            let polygon: Vec<Vec3> = corners
+                .iter()
+                .map(|&c| points[indices[c] as usize])
+                .collect();
+            for [a, b, c] in triangulate(&polygon) {
+                let tri = [corners[a], corners[b], corners[c]];
+                let tri = if left_handed {
+                    [tri[0], tri[2], tri[1]]
+                } else {
+                    tri
+                };
+                by_material
+                    .entry(face_material[face])
+                    .or_default()
+                    .push(tri);
+            }
+        }
+        let corner_face: Vec<usize> = counts
+            .iter()
+            .enumerate()
+            .flat_map(|(f, &c)| std::iter::repeat_n(f, c as usize))
+            .collect();
+        // The value a primvar gives face corner `corner`.
+        fn pick<T: Copy>(
+            values: &[T],
+            interpolation: Interpolation,
+            corner: usize,
+            face: usize,
+            point: usize,
+        ) -> Option<T> {
+            match interpolation {
+                Interpolation::Constant => values.first().copied(),
+                Interpolation::Uniform => values.get(face).copied(),
+                Interpolation::Vertex => values.get(point).copied(),
+                Interpolation::FaceVarying => values.get(corner).copied(),
+            }
+        }
+        let transform = Affine3A::from_mat4(world);
+        let mut materials: Vec<(usize, Vec<[usize; 3]>)> = by_material.into_iter().collect();
+        materials.sort_by_key(|(m, _)| *m);
+        for (material, triangles) in materials {
+            // One vertex per triangle corner: normals and UVs may differ at every corner.
+            let mut mesh = Mesh {
+                name: where_.clone(),
+                material,
+                ..Mesh::default()
+            };
+            let mut normals_ok = normals.is_some();
+            let mut st = Vec::new();
+            for (t, tri) in triangles.iter().enumerate() {
+                for &corner in tri {
+                    let (face, point) = (corner_face[corner], indices[corner] as usize);
+                    mesh.positions.push(points[point]);
+                    if let Some((values, interpolation)) = &normals {
+                        match pick(values, *interpolation, corner, face, point) {
+                            Some(n) => mesh.normals.push(n.normalize_or_zero()),
+                            None => normals_ok = false,
+                        }
+                    }
+                    if let Some((values, interpolation)) = &uvs {
+                        let v = pick(values, *interpolation, corner, face, point);
+                        // USD's st has v up the image; glTF's (and ours) runs down.
+                        st.push(v.map_or(Vec2::ZERO, |v| Vec2::new(v.x, 1.0 - v.y)));
+                    }
+                }
+                let base = 3 * t as u32;
+                mesh.indices.push([base, base + 1, base + 2]);
+            }
+            if !normals_ok || mesh.normals.contains(&Vec3::ZERO) {
+                mesh.normals.clear();
+            }
+            if !st.is_empty() {
+                mesh.uvs = vec![st];
+            }
+            if !double_sided {
+                mesh.material = self.one_sided(material);
+            }
+            let index = self.builder.add_full_mesh(mesh);
+            self.builder.add_instance(index, transform, where_.clone());
+        }
+        Ok(())
+    }
+
+    /// The one-sided variant of material `index`, made once. UsdGeom's `doubleSided` (false
+    /// by default; Blender writes true) belongs to the mesh, gridtrace's to the material:
+    /// one-sided means what it does for glTF (a black back face), except for glass, whose
+    /// back faces are the inside of its volume.
+    fn one_sided(&mut self, index: usize) -> usize {
+        if let Some(&variant) = self.one_sided.get(&index) {
+            return variant;
+        }
+        let mut material = self.builder.material_mut(index).clone();
+        let variant = if matches!(material.kind, MaterialKind::Glass { .. }) {
+            index
+        } else {
+            material.double_sided = false;
+            material.name = format!("{} (one-sided)", material.name);
+            self.builder.add_material(material)
+        };
+        self.one_sided.insert(index, variant);
+        variant
+    }
+
+    /// The material bound to `prim` (`material:binding`), converted once per material.
+    fn bound_material(&mut self, prim: &sdf::Path) -> usize {
+        let target = prim
+            .append_property("material:binding")
+            .ok()
+            .and_then(|rel| self.stage.relationship(rel).targets().ok())
+            .and_then(|t| t.into_iter().next());
+        let Some(target) = target else {
+            return self.default_material();
+        };
+        let key = target.as_str().to_string();
+        if let Some(&m) = self.materials.get(&key) {
+            return m;
+        }
+        let material = self.convert_material(&target);
+        let index = self.builder.add_material(material);
+        self.materials.insert(key, index);
+        index
+    }
+
+    fn default_material(&mut self) -> usize {
+        if let Some(m) = self.default_material {
+            return m;
+        }
+        let m = self
+            .builder
+            .add_material(Material::diffuse("default", Vec3::splat(0.8)));
+        self.default_material = Some(m);
+        m
+    }
+
+    /// A `UsdPreviewSurface` material, mapped as glTF's are.
+    fn convert_material(&mut self, material: &sdf::Path) -> Material {
+        let name = material.as_str().to_string();
+        let surface = material
+            .append_property("outputs:surface")
+            .ok()
+            .and_then(|p| self.stage.attribute(p).connections().ok())
+            .and_then(|c| c.into_iter().next())
+            .map(|p| p.prim_path());
+        let Some(shader) = surface else {
+            self.warn(format!(
+                "{name}: material has no surface shader; using grey diffuse"
+            ));
+            return Material::diffuse(name, Vec3::splat(0.8));
+        };
+        let id = self.get_token(&shader, "info:id").unwrap_or_default();
+        if id != "UsdPreviewSurface" {
+            self.warn(format!(
+                "{name}: surface shader '{id}' is not UsdPreviewSurface; using grey diffuse"
+            ));
+            return Material::diffuse(name, Vec3::splat(0.8));
+        }
+        let colour = |loader: &mut UsdLoader, input: &str, default: Vec3| {
+            loader.warn_if_connected(&shader, input, &name);
+            loader
+                .get(&shader, input)
+                .as_ref()
+                .and_then(as_vec3)
+                .unwrap_or(default)
+        };
+        let scalar = |loader: &mut UsdLoader, input: &str, default: f32| {
+            loader.warn_if_connected(&shader, input, &name);
+            loader.get_f32(&shader, input).unwrap_or(default)
+        };
+        let diffuse = colour(self, "inputs:diffuseColor", Vec3::splat(0.18));
+        let emission = colour(self, "inputs:emissiveColor", Vec3::ZERO);
+        let metallic = scalar(self, "inputs:metallic", 0.0);
+        let opacity = scalar(self, "inputs:opacity", 1.0);
+        let ior = scalar(self, "inputs:ior", 1.5);
+        let roughness = scalar(self, "inputs:roughness", 0.5);
+        let kind = if opacity < 0.5 {
+            MaterialKind::Glass { ior, tint: diffuse }
+        } else if metallic >= 0.5 {
+            MaterialKind::Mirror {
+                reflectance: diffuse,
+            }
+        } else {
+            MaterialKind::Diffuse { albedo: diffuse }
+        };
+        if !matches!(kind, MaterialKind::Diffuse { .. }) && roughness > 0.05 {
+            self.warn(format!(
+                "{name}: roughness {roughness} is rendered as perfectly smooth (gridtrace's mirror and glass are ideal)"
+            ));
+        }
+        Material {
+            emission,
+            ..Material::new(name, kind)
+        }
+    }
+
+    /// Textures and other networks feeding an input are not read yet: say so.
+    fn warn_if_connected(&mut self, shader: &sdf::Path, input: &str, material: &str) {
+        let connected = shader
+            .append_property(input)
+            .ok()
+            .and_then(|p| self.stage.attribute(p).connections().ok())
+            .is_some_and(|c| !c.is_empty());
+        if connected {
+            self.warn(format!(
+                "{material}: {input} is connected to a shader network (textures are not read from USD yet); using its constant value"
+            ));
+        }
+    }
+
+    fn add_camera(&mut self, prim: &sdf::Path, world: Mat4) {
+        let where_ = prim.as_str().to_string();
+        // Apertures and focal length share a unit (tenths of a scene unit), so their ratio
+        // is the field of view; the defaults are USD's.
+        let focal = self.get_f32(prim, "focalLength").unwrap_or(50.0);
+        let horizontal = self.get_f32(prim, "horizontalAperture").unwrap_or(20.955);
+        let vertical = self.get_f32(prim, "verticalAperture").unwrap_or(15.2908);
+        let znear = match self.get(prim, "clippingRange") {
+            Some(sdf::Value::Vec2f(r)) => r.x,
+            Some(sdf::Value::Vec2d(r)) => r.x as f32,
+            _ => 1.0,
+        };
+        let (scale, rotation, translation) = world.to_scale_rotation_translation();
+        let projection = if self.get_token(prim, "projection").as_deref() == Some("orthographic") {
+            // Apertures in tenths of a scene unit, here after the stage's scale.
+            Projection::Orthographic {
+                xmag: 0.05 * horizontal * scale.x,
+                ymag: 0.05 * vertical * scale.y,
+            }
+        } else {
+            if !(focal > 0.0 && vertical > 0.0 && horizontal > 0.0) {
+                self.warn(format!(
+                    "{where_}: camera with zero focal length or aperture; skipped"
+                ));
+                return;
+            }
+            Projection::Perspective {
+                yfov: 2.0 * (0.5 * vertical / focal).atan(),
+                aspect_ratio: Some(horizontal / vertical),
+            }
+        };
+        self.builder.add_camera(Camera {
+            name: where_.clone(),
+            world_from_camera: Affine3A::from_rotation_translation(
+                rotation.normalize(),
+                translation,
+            ),
+            projection,
+            znear: znear * scale.y,
+            source: where_,
+        });
+    }
+
+    /// UsdLux lights. Radiance (area lights) or radiant intensity (points) is
+    /// `intensity × 2^exposure × color`; `normalize` divides by the light's area, so that
+    /// the power (π × radiance × area) stays `π × intensity` whatever its size — which is
+    /// how Blender writes watts (intensity = W/π).
+    fn add_light(&mut self, prim: &sdf::Path, kind: &str, world: Mat4) {
+        let where_ = prim.as_str().to_string();
+        let intensity = self.get_f32(prim, "inputs:intensity").unwrap_or(1.0);
+        let exposure = self.get_f32(prim, "inputs:exposure").unwrap_or(0.0);
+        let colour = self
+            .get(prim, "inputs:color")
+            .as_ref()
+            .and_then(as_vec3)
+            .unwrap_or(Vec3::ONE);
+        let normalize = self
+            .get(prim, "inputs:normalize")
+            .as_ref()
+            .and_then(as_bool)
+            .unwrap_or(false);
+        if self
+            .get(prim, "inputs:enableColorTemperature")
+            .as_ref()
+            .and_then(as_bool)
+            == Some(true)
+        {
+            self.warn(format!(
+                "{where_}: colour temperature is not supported; using the colour alone"
+            ));
+        }
+        let strength = colour * intensity * exposure.exp2();
+        if !strength.is_finite() || strength.min_element() < 0.0 {
+            self.warn(format!(
+                "{where_}: negative or non-finite light strength; skipped"
+            ));
+            return;
+        }
+        let transform = Affine3A::from_mat4(world);
+        // World-space area scale of the light's local XY plane.
+        let area_scale = transform
+            .matrix3
+            .x_axis
+            .cross(transform.matrix3.y_axis)
+            .length();
+        let emitter =
+            |loader: &mut UsdLoader, positions: Vec<Vec3>, indices: Vec<[u32; 3]>, area: f32| {
+                let radiance = if normalize {
+                    strength / (area * area_scale).max(f32::MIN_POSITIVE)
+                } else {
+                    strength
+                };
+                let material = loader.builder.add_material(Material {
+                    double_sided: false,
+                    ..Material::diffuse(where_.clone(), Vec3::ZERO).with_emission(radiance)
+                });
+                let mesh = loader
+                    .builder
+                    .add_mesh(where_.clone(), positions, indices, material);
+                loader.builder.add_instance(mesh, transform, where_.clone());
+            };
+        match kind {
+            "RectLight" => {
+                let w = 0.5 * self.get_f32(prim, "inputs:width").unwrap_or(1.0);
+                let h = 0.5 * self.get_f32(prim, "inputs:height").unwrap_or(1.0);
+                // In the XY plane, emitting towards −Z: wound clockwise seen from +Z.
+                let positions = vec![
+                    Vec3::new(-w, -h, 0.0),
+                    Vec3::new(-w, h, 0.0),
+                    Vec3::new(w, h, 0.0),
+                    Vec3::new(w, -h, 0.0),
+                ];
+                emitter(self, positions, vec![[0, 1, 2], [0, 2, 3]], 4.0 * w * h);
+            }
+            "DiskLight" => {
+                let r = self.get_f32(prim, "inputs:radius").unwrap_or(0.5);
+                let mut positions = vec![Vec3::ZERO];
+                positions.extend((0..DISK_SEGMENTS).map(|i| {
+                    let a = -std::f32::consts::TAU * i as f32 / DISK_SEGMENTS as f32;
+                    Vec3::new(r * a.cos(), r * a.sin(), 0.0)
+                }));
+                let indices = (0..DISK_SEGMENTS)
+                    .map(|i| [0, 1 + i, 1 + (i + 1) % DISK_SEGMENTS])
+                    .collect();
+                let area = 0.5
+                    * DISK_SEGMENTS as f32
+                    * r
+                    * r
+                    * (std::f32::consts::TAU / DISK_SEGMENTS as f32).sin();
+                emitter(self, positions, indices, area);
+            }
+            "SphereLight" => {
+                let r = self.get_f32(prim, "inputs:radius").unwrap_or(0.5) * area_scale.sqrt();
+                // A sphere of radiance L emits π·L·4πr² in all, i.e. L·πr² per steradian;
+                // normalized, L = intensity / 4πr², so intensity / 4 per steradian.
+                let per_steradian = if normalize || r == 0.0 {
+                    strength / 4.0
+                } else {
+                    strength * std::f32::consts::PI * r * r
+                };
+                if self.get(prim, "treatAsPoint").as_ref().and_then(as_bool) != Some(true)
+                    && r > 0.0
+                {
+                    self.warn(format!(
+                        "{where_}: SphereLight of radius {r} is rendered as a point light"
+                    ));
+                }
+                let position = transform.transform_point3(Vec3::ZERO);
+                let kind = match self.get_f32(prim, "inputs:shaping:cone:angle") {
+                    Some(angle) if angle < 180.0 => {
+                        let softness = self
+                            .get_f32(prim, "inputs:shaping:cone:softness")
+                            .unwrap_or(0.0)
+                            .clamp(0.0, 1.0);
+                        let outer = angle.to_radians().min(std::f32::consts::FRAC_PI_2);
+                        LightKind::Spot {
+                            position,
+                            direction: transform.transform_vector3(Vec3::NEG_Z).normalize_or_zero(),
+                            intensity: per_steradian,
+                            cos_inner: (outer * (1.0 - softness)).cos(),
+                            cos_outer: outer.cos(),
+                            range: None,
+                        }
+                    }
+                    _ => LightKind::Point {
+                        position,
+                        intensity: per_steradian,
+                        range: None,
+                    },
+                };
+                self.builder.add_light(Light {
+                    name: where_.clone(),
+                    kind,
+                    source: where_,
+                });
+            }
+            "DistantLight" => {
+                let direction = transform.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+                self.builder.add_light(Light {
+                    name: where_.clone(),
+                    kind: LightKind::Directional {
+                        direction,
+                        irradiance: strength,
+                    },
+                    source: where_,
+                });
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Triangles (as corner positions in `polygon`) covering a planar polygon: a fan when it is
+/// convex, ear clipping (Eberly, "Triangulation by Ear Clipping", 2002) otherwise.
+fn triangulate(polygon: &[Vec3]) -> Vec<[usize; 3]> {
+    let n = polygon.len();
+    if n < 3 {
+        return Vec::new();
+    }
+    // Newell's normal: robust for any planar polygon.
+    let mut normal = Vec3::ZERO;
+    for i in 0..n {
+        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+        normal += Vec3::new(
+            (a.y - b.y) * (a.z + b.z),
+            (a.z - b.z) * (a.x + b.x),
+            (a.x - b.x) * (a.y + b.y),
+        );
+    }
+    let convex_at = |a: Vec3, b: Vec3, c: Vec3| (b - a).cross(c - b).dot(normal) >= 0.0;
+    if n == 3 || (0..n).all(|i| convex_at(polygon[i], polygon[(i + 1) % n], polygon[(i + 2) % n])) {
+        return (1..n - 1).map(|i| [0, i, i + 1]).collect();
+    }
+    let mut remaining: Vec<usize> = (0..n).collect();
+    let mut triangles = Vec::with_capacity(n - 2);
+    let inside = |p: Vec3, a: Vec3, b: Vec3, c: Vec3| {
+        (b - a).cross(p - a).dot(normal) > 0.0
+            && (c - b).cross(p - b).dot(normal) > 0.0
+            && (a - c).cross(p - c).dot(normal) > 0.0
+    };
+    while remaining.len() > 3 {
+        let m = remaining.len();
+        let ear = (0..m).find(|&i| {
+            let (ia, ib, ic) = (
+                remaining[(i + m - 1) % m],
+                remaining[i],
+                remaining[(i + 1) % m],
+            );
+            let (a, b, c) = (polygon[ia], polygon[ib], polygon[ic]);
+            convex_at(a, b, c)
+                && !remaining
+                    .iter()
+                    .any(|&j| j != ia && j != ib && j != ic && inside(polygon[j], a, b, c))
+        });
+        // A degenerate or self-intersecting polygon has no ear: cut the first corner.
+        let i = ear.unwrap_or(0);
+        triangles.push([
+            remaining[(i + m - 1) % m],
+            remaining[i],
+            remaining[(i + 1) % m],
+        ]);
+        remaining.remove(i);
+    }
+    triangles.push([remaining[0], remaining[1], remaining[2]]);
+    triangles
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area(polygon: &[Vec3], triangles: &[[usize; 3]]) -> f32 {
+        triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| polygon[i]);
+                0.5 * (b - a).cross(c - a).dot(Vec3::Z)
+            })
+            .sum()
+    }
+
+    #[test]
+    fn convex_polygons_become_fans_and_concave_ones_ears() {
+        let square = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        assert_eq!(triangulate(&square), vec![[0, 1, 2], [0, 2, 3]]);
+        // An L shape (area 3) whose fan from corner 0 would cover the notch.
+        let l = [
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(2.0, 1.0, 0.0),
+            Vec3::new(2.0, 2.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+        ];
+        let tris = triangulate(&l);
+        assert_eq!(tris.len(), 4);
+        assert!((area(&l, &tris) - 3.0).abs() < 1e-6, "{tris:?}");
+        // Every triangle keeps the polygon's orientation (positive area).
+        assert!(tris.iter().all(|t| area(&l, &[*t]) > 0.0), "{tris:?}");
+    }
+}

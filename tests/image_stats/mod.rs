@@ -1,0 +1,263 @@
+//! Comparing two renders within their measured noise, for the reference-image and
+//! cross-format tests.
+//!
+//! Each side is two independent half renders, so each pixel's noise is measured, not
+//! guessed: for two halves A and B of a pixel, the variance of their mean is estimated by
+//! (A − B)²/4. Pixels are independent, so a block's variance is the sum of its pixels'
+//! variances over the squared pixel count.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use gridtrace::load::load_scene;
+use gridtrace::output::write_image;
+use gridtrace::render::{Image, RenderSettings, Renderer};
+
+/// Width and height of the references.
+pub const SIZE: usize = 128;
+/// Side of the square blocks compared.
+pub const BLOCK: usize = 8;
+/// Deepest path: the references use 64 bounces, so neither side cuts paths short.
+pub const MAX_DEPTH: u32 = 64;
+/// Largest allowed |z| of any block and channel. With 256 blocks × 3 channels = 768 tests,
+/// a Gaussian exceeds 5 standard errors somewhere with probability 768 × 5.7e-7 ≈ 4e-4.
+pub const MAX_BLOCK_Z: f64 = 5.0;
+/// Largest allowed root-mean-square z over all blocks and channels. Pure noise gives ≈ 1
+/// (1.03 with 64-pixel variance estimates); 1.3 flags a systematic error of ~0.8 standard
+/// errors in every block.
+pub const MAX_RMS_Z: f64 = 1.3;
+/// Largest allowed relative difference of a channel's image mean.
+pub const MAX_MEAN_ERROR: f64 = 0.02;
+
+/// Two independent halves of one render, per pixel.
+pub struct Halves {
+    pub a: Vec<DVec3>,
+    pub b: Vec<DVec3>,
+}
+
+impl Halves {
+    pub fn mean(&self, i: usize) -> DVec3 {
+        0.5 * (self.a[i] + self.b[i])
+    }
+
+    /// Estimated variance of [`Halves::mean`] at pixel `i`.
+    pub fn variance(&self, i: usize) -> DVec3 {
+        let d = self.a[i] - self.b[i];
+        0.25 * d * d
+    }
+
+    pub fn image_mean(&self) -> DVec3 {
+        (0..self.a.len()).map(|i| self.mean(i)).sum::<DVec3>() / self.a.len() as f64
+    }
+
+    /// Block means and their estimated variances, blocks in row-major order.
+    pub fn blocks(&self) -> Vec<(DVec3, DVec3)> {
+        let per_side = SIZE / BLOCK;
+        let n = (BLOCK * BLOCK) as f64;
+        let mut blocks = Vec::new();
+        for by in 0..per_side {
+            for bx in 0..per_side {
+                let (mut sum, mut var) = (DVec3::ZERO, DVec3::ZERO);
+                for y in by * BLOCK..(by + 1) * BLOCK {
+                    for x in bx * BLOCK..(bx + 1) * BLOCK {
+                        sum += self.mean(y * SIZE + x);
+                        var += self.variance(y * SIZE + x);
+                    }
+                }
+                blocks.push((sum / n, var / (n * n)));
+            }
+        }
+        blocks
+    }
+
+    pub fn to_image(&self, f: impl Fn(usize) -> DVec3) -> Image {
+        let mut image = Image::new(SIZE as u32, SIZE as u32);
+        for (i, p) in image.pixels.iter_mut().enumerate() {
+            *p = f(i).as_vec3();
+        }
+        image.alpha.fill(1.0);
+        image
+    }
+}
+
+pub fn read_exr(path: &Path) -> Vec<DVec3> {
+    let shown = path.display().to_string();
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        move |resolution, _| {
+            assert_eq!(
+                (resolution.width(), resolution.height()),
+                (SIZE, SIZE),
+                "{shown}"
+            );
+            vec![DVec3::ZERO; SIZE * SIZE]
+        },
+        |pixels: &mut Vec<DVec3>, position, (r, g, b, _): (f32, f32, f32, f32)| {
+            pixels[position.y() * SIZE + position.x()] = DVec3::new(r as f64, g as f64, b as f64);
+        },
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    image.layer_data.channel_data.pixels
+}
+
+pub fn reference(name: &str) -> Halves {
+    let dir = Path::new("tests/references");
+    Halves {
+        a: read_exr(&dir.join(format!("{name}_a.exr"))),
+        b: read_exr(&dir.join(format!("{name}_b.exr"))),
+    }
+}
+
+pub fn scene_path(name: &str) -> PathBuf {
+    let asset = Path::new("assets").join(format!("{name}.glb"));
+    if asset.exists() {
+        asset
+    } else {
+        Path::new("tests/scenes").join(format!("{name}.glb"))
+    }
+}
+
+/// Renders `spp` samples per pixel of the scene through its first camera with `seed`.
+pub fn render(
+    renderer: &Renderer,
+    camera: &gridtrace::scene::Camera,
+    spp: u32,
+    seed: u64,
+) -> Vec<DVec3> {
+    let settings = RenderSettings {
+        width: SIZE as u32,
+        height: SIZE as u32,
+        spp,
+        max_depth: MAX_DEPTH,
+        seed,
+        ..RenderSettings::default()
+    };
+    let (image, stats) = renderer.render(camera, &settings, &|| {});
+    assert_eq!(stats.nonfinite, 0, "non-finite samples");
+    image.pixels.iter().map(|p| p.as_dvec3()).collect()
+}
+
+/// What the comparison of one scene measured.
+pub struct Comparison {
+    pub mean_ratio: DVec3,
+    pub max_z: f64,
+    pub rms_z: f64,
+    /// Mean over blocks of |gridtrace − reference| / reference, per channel averaged.
+    pub mean_block_error: f64,
+    /// The same for the reference-plus-gridtrace noise: the error pure noise would give.
+    pub mean_block_noise: f64,
+}
+
+pub fn compare(gridtrace: &Halves, reference: &Halves) -> Comparison {
+    let mean_ratio = gridtrace.image_mean() / reference.image_mean();
+    let (mut max_z, mut sum_z2, mut n) = (0.0f64, 0.0f64, 0usize);
+    let (mut error, mut noise, mut counted) = (0.0f64, 0.0f64, 0usize);
+    for ((g, vg), (r, vr)) in gridtrace.blocks().into_iter().zip(reference.blocks()) {
+        for c in 0..3 {
+            let sigma = (vg[c] + vr[c]).sqrt();
+            let diff = g[c] - r[c];
+            let z = if sigma > 0.0 {
+                diff / sigma
+            } else if diff == 0.0 {
+                0.0
+            } else {
+                f64::INFINITY
+            };
+            max_z = max_z.max(z.abs());
+            sum_z2 += z * z;
+            n += 1;
+            if r[c] > 0.0 {
+                error += diff.abs() / r[c];
+                noise += sigma / r[c];
+                counted += 1;
+            }
+        }
+    }
+    Comparison {
+        mean_ratio,
+        max_z,
+        rms_z: (sum_z2 / n as f64).sqrt(),
+        mean_block_error: error / counted.max(1) as f64,
+        // E|N(0, σ)| = σ·√(2/π).
+        mean_block_noise: noise / counted.max(1) as f64 * (2.0 / std::f64::consts::PI).sqrt(),
+    }
+}
+
+/// Writes gridtrace, reference and their difference next to the test binaries for a look.
+pub fn write_difference_images(name: &str, gridtrace: &Halves, reference: &Halves) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reference-images");
+    std::fs::create_dir_all(&dir).unwrap();
+    let images = [
+        ("gridtrace", gridtrace.to_image(|i| gridtrace.mean(i))),
+        ("reference", reference.to_image(|i| reference.mean(i))),
+        (
+            "difference",
+            gridtrace.to_image(|i| gridtrace.mean(i) - reference.mean(i)),
+        ),
+    ];
+    for (kind, image) in images {
+        write_image(&dir.join(format!("{name}_{kind}.exr")), &image).unwrap();
+    }
+    dir
+}
+
+/// Renders `path` through its first camera in two halves of `spp / 2` samples, seeded
+/// `first_seed` and `first_seed + 1`.
+pub fn render_halves(path: &Path, spp: u32, first_seed: u64) -> Halves {
+    let loaded = load_scene(path).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let scene = loaded.scene;
+    let camera = scene
+        .cameras
+        .first()
+        .expect("the scene has a camera")
+        .clone();
+    let renderer = Renderer::new(&scene);
+    Halves {
+        a: render(&renderer, &camera, spp / 2, first_seed),
+        b: render(&renderer, &camera, spp / 2, first_seed + 1),
+    }
+}
+
+/// Panics, printing the numbers and writing the images, unless `ours` and `theirs` agree:
+/// image means within 2 %, every block within 5 standard errors, rms z under 1.3.
+pub fn check_agreement(what: &str, ours: &Halves, theirs: &Halves) {
+    let c = compare(ours, theirs);
+    let report = format!(
+        "{what}: mean ratio R {:.4} G {:.4} B {:.4}; \
+         {BLOCK}×{BLOCK} blocks: max |z| {:.2}, rms z {:.2}, mean relative error {:.4} \
+         (noise alone: {:.4})",
+        c.mean_ratio.x,
+        c.mean_ratio.y,
+        c.mean_ratio.z,
+        c.max_z,
+        c.rms_z,
+        c.mean_block_error,
+        c.mean_block_noise,
+    );
+    println!("{report}");
+    let mean_ok = (c.mean_ratio - DVec3::ONE).abs().max_element() < MAX_MEAN_ERROR;
+    if !(mean_ok && c.max_z < MAX_BLOCK_Z && c.rms_z < MAX_RMS_Z) {
+        let name: String = what
+            .chars()
+            .map(|c| if c.is_alphanumeric() { c } else { '_' })
+            .collect();
+        let dir = write_difference_images(&name, ours, theirs);
+        panic!(
+            "{report}\nlimits: mean within {MAX_MEAN_ERROR}, max |z| < {MAX_BLOCK_Z}, \
+             rms z < {MAX_RMS_Z}; images in {}",
+            dir.display()
+        );
+    }
+}
+
+/// gridtrace's render of reference scene `name` against Cycles' (ratio = gridtrace/Cycles).
+pub fn check_scene(name: &str, spp: u32) {
+    let ours = render_halves(&scene_path(name), spp, 1);
+    check_agreement(
+        &format!("{name} at {spp} spp vs Cycles"),
+        &ours,
+        &reference(name),
+    );
+}

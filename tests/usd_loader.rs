@@ -1,0 +1,451 @@
+//! The USD loader: Blender's USD export renders like its glTF export, and a hand-written
+//! stage exercises transforms, units, axes, topology, materials, cameras and lights.
+
+mod image_stats;
+
+use std::path::Path;
+
+use glam::Vec3;
+use gridtrace::load::{LoadError, load_scene};
+use gridtrace::scene::{LightKind, MaterialKind, Projection, Scene};
+use image_stats::{check_agreement, render_halves};
+
+/// Blender's Cornell box through its USD exporter (Z-up, metres, UsdPreviewSurface) and
+/// through its glTF exporter must be the same image within noise.
+#[test]
+fn blender_cornell_box_from_usdc_renders_like_the_glb() {
+    let usd = render_halves(Path::new("assets/cornell_box.usdc"), 256, 11);
+    let gltf = render_halves(Path::new("assets/cornell_box.glb"), 256, 21);
+    check_agreement("cornell_box.usdc vs cornell_box.glb", &usd, &gltf);
+}
+
+const STAGE: &str = r#"#usda 1.0
+(
+    upAxis = "Z"
+    metersPerUnit = 0.01
+)
+
+def Xform "World"
+{
+    double3 xformOp:translate = (100, 0, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+
+    def Mesh "Tri"
+    {
+        int[] faceVertexCounts = [3]
+        int[] faceVertexIndices = [0, 1, 2]
+        point3f[] points = [(0, 0, 0), (100, 0, 0), (0, 100, 0)]
+        uniform bool doubleSided = 1
+        rel material:binding = </World/Looks/Red>
+    }
+
+    def Mesh "LeftHanded"
+    {
+        int[] faceVertexCounts = [3]
+        int[] faceVertexIndices = [0, 1, 2]
+        point3f[] points = [(0, 0, 0), (100, 0, 0), (0, 100, 0)]
+        uniform token orientation = "leftHanded"
+        rel material:binding = </World/Looks/Red>
+    }
+
+    def Mesh "Hidden"
+    {
+        token visibility = "invisible"
+        int[] faceVertexCounts = [3]
+        int[] faceVertexIndices = [0, 1, 2]
+        point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+    }
+
+    def Mesh "Guide"
+    {
+        uniform token purpose = "guide"
+        int[] faceVertexCounts = [3]
+        int[] faceVertexIndices = [0, 1, 2]
+        point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+    }
+
+    def Mesh "Concave"
+    {
+        int[] faceVertexCounts = [6]
+        int[] faceVertexIndices = [0, 1, 2, 3, 4, 5]
+        point3f[] points = [(1, 1, 0), (2, 1, 0), (2, 2, 0), (0, 2, 0), (0, 0, 0), (1, 0, 0)]
+        normal3f[] primvars:normals = [(0, 0, 1)] (
+            interpolation = "constant"
+        )
+        texCoord2f[] primvars:st = [(0, 0), (1, 0), (1, 1), (0, 1), (0, 0), (1, 0)] (
+            interpolation = "faceVarying"
+        )
+        uniform token subdivisionScheme = "catmullClark"
+    }
+
+    def Mesh "Subsets"
+    {
+        int[] faceVertexCounts = [4, 4]
+        int[] faceVertexIndices = [0, 1, 2, 3, 1, 4, 5, 2]
+        point3f[] points = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (2, 0, 0), (2, 1, 0)]
+        rel material:binding = </World/Looks/Red>
+
+        def GeomSubset "Second"
+        {
+            uniform token elementType = "face"
+            uniform token familyName = "materialBind"
+            int[] indices = [1]
+            rel material:binding = </World/Looks/Mirror>
+        }
+    }
+
+    def Xform "Reset"
+    {
+        double3 xformOp:translate = (0, 0, 50)
+        uniform token[] xformOpOrder = ["!resetXformStack!", "xformOp:translate"]
+
+        def Mesh "Lifted"
+        {
+            int[] faceVertexCounts = [3]
+            int[] faceVertexIndices = [0, 1, 2]
+            point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+            rel material:binding = </World/Looks/Glass>
+        }
+    }
+
+    def Xform "Ops"
+    {
+        float3 xformOp:rotateXYZ = (0, 0, 90)
+        float3 xformOp:scale = (2, 2, 2)
+        double3 xformOp:translate:offset = (10, 0, 0)
+        uniform token[] xformOpOrder = ["xformOp:rotateXYZ", "xformOp:scale", "xformOp:translate:offset", "!invert!xformOp:translate:offset"]
+
+        def Mesh "Turned"
+        {
+            int[] faceVertexCounts = [3]
+            int[] faceVertexIndices = [0, 1, 2]
+            point3f[] points = [(10, 0, 0), (10, 1, 0), (9, 0, 0)]
+            rel material:binding = </World/Looks/Emit>
+        }
+    }
+
+    def Camera "Cam"
+    {
+        float focalLength = 50
+        float horizontalAperture = 36
+        float verticalAperture = 24
+        float2 clippingRange = (10, 10000)
+    }
+
+    def RectLight "Panel"
+    {
+        float inputs:intensity = 10
+        float inputs:exposure = 1
+        float inputs:width = 200
+        float inputs:height = 100
+        bool inputs:normalize = 1
+    }
+
+    def SphereLight "Bulb"
+    {
+        float inputs:intensity = 8
+        color3f inputs:color = (1, 0.5, 0.25)
+        float inputs:radius = 0
+        bool treatAsPoint = 1
+    }
+
+    def DistantLight "Sun"
+    {
+        float inputs:intensity = 3
+    }
+
+    def DomeLight "Sky"
+    {
+    }
+
+    def Sphere "Ball"
+    {
+    }
+
+    def Scope "Looks"
+    {
+        def Material "Red"
+        {
+            token outputs:surface.connect = </World/Looks/Red/Surface.outputs:surface>
+            def Shader "Surface"
+            {
+                uniform token info:id = "UsdPreviewSurface"
+                color3f inputs:diffuseColor = (0.8, 0.1, 0.1)
+                token outputs:surface
+            }
+        }
+        def Material "Mirror"
+        {
+            token outputs:surface.connect = </World/Looks/Mirror/Surface.outputs:surface>
+            def Shader "Surface"
+            {
+                uniform token info:id = "UsdPreviewSurface"
+                color3f inputs:diffuseColor = (0.9, 0.9, 0.9)
+                float inputs:metallic = 1
+                float inputs:roughness = 0
+                token outputs:surface
+            }
+        }
+        def Material "Glass"
+        {
+            token outputs:surface.connect = </World/Looks/Glass/Surface.outputs:surface>
+            def Shader "Surface"
+            {
+                uniform token info:id = "UsdPreviewSurface"
+                color3f inputs:diffuseColor = (1, 1, 1)
+                float inputs:opacity = 0.1
+                float inputs:ior = 1.33
+                float inputs:roughness = 0
+                token outputs:surface
+            }
+        }
+        def Material "Emit"
+        {
+            token outputs:surface.connect = </World/Looks/Emit/Surface.outputs:surface>
+            def Shader "Surface"
+            {
+                uniform token info:id = "UsdPreviewSurface"
+                color3f inputs:diffuseColor = (0, 0, 0)
+                color3f inputs:emissiveColor = (5, 4, 3)
+                token outputs:surface
+            }
+        }
+    }
+}
+"#;
+
+/// World-space corners of each instanced triangle of the instance named `source`.
+fn world_triangles(scene: &Scene, source: &str) -> Vec<[Vec3; 3]> {
+    scene
+        .instances
+        .iter()
+        .filter(|i| i.source == source)
+        .flat_map(|inst| {
+            let mesh = &scene.meshes[inst.mesh];
+            mesh.indices.iter().map(move |t| {
+                t.map(|v| {
+                    inst.world_from_object
+                        .transform_point3(mesh.positions[v as usize])
+                })
+            })
+        })
+        .collect()
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).abs().max_element() < 1e-5
+}
+
+#[test]
+fn a_hand_written_stage_loads_as_usd_defines_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stage.usda");
+    std::fs::write(&path, STAGE).unwrap();
+    let loaded = load_scene(&path).unwrap();
+    let scene = &loaded.scene;
+    let warnings = loaded.warnings.join("\n");
+
+    // Z-up centimetres become Y-up metres: stage (x, y, z) cm → (x, z, −y) / 100.
+    let tri = world_triangles(scene, "/World/Tri");
+    assert_eq!(tri.len(), 1);
+    assert!(close(tri[0][0], Vec3::new(1.0, 0.0, 0.0)), "{:?}", tri[0]);
+    assert!(close(tri[0][1], Vec3::new(2.0, 0.0, 0.0)), "{:?}", tri[0]);
+    assert!(close(tri[0][2], Vec3::new(1.0, 0.0, -1.0)), "{:?}", tri[0]);
+    // Counter-clockwise about stage +Z, which is world +Y.
+    let n = (tri[0][1] - tri[0][0]).cross(tri[0][2] - tri[0][0]);
+    assert!(n.y > 0.0, "{n}");
+    // leftHanded reverses the winding.
+    let left = world_triangles(scene, "/World/LeftHanded");
+    let n = (left[0][1] - left[0][0]).cross(left[0][2] - left[0][0]);
+    assert!(n.y < 0.0, "{n}");
+    // Invisible and guide prims are skipped; the Sphere gprim is reported.
+    assert!(world_triangles(scene, "/World/Hidden").is_empty());
+    assert!(world_triangles(scene, "/World/Guide").is_empty());
+    assert!(
+        warnings.contains("/World/Ball: Sphere prims are not supported"),
+        "{warnings}"
+    );
+
+    // A concave hexagon (an L of area 3 cm²) becomes four triangles covering it exactly.
+    let concave = world_triangles(scene, "/World/Concave");
+    assert_eq!(concave.len(), 4);
+    let area: f32 = concave
+        .iter()
+        .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
+        .sum();
+    assert!((area - 3e-4).abs() < 1e-8, "{area}");
+    let mesh = scene
+        .meshes
+        .iter()
+        .find(|m| m.name == "/World/Concave")
+        .unwrap();
+    assert_eq!(mesh.uvs.len(), 1);
+    assert!(mesh.normals.iter().all(|n| *n == Vec3::Z));
+    assert!(
+        warnings.contains(
+            "/World/Concave: subdivisionScheme 'catmullClark' is rendered as its control cage"
+        ),
+        "{warnings}"
+    );
+
+    // GeomSubsets split the mesh by material.
+    let subset_materials: Vec<&str> = scene
+        .instances
+        .iter()
+        .filter(|i| i.source == "/World/Subsets")
+        .map(|i| scene.materials[scene.meshes[i.mesh].material].name.as_str())
+        .collect();
+    assert_eq!(
+        subset_materials,
+        [
+            "/World/Looks/Red (one-sided)",
+            "/World/Looks/Mirror (one-sided)"
+        ],
+        "unauthored doubleSided is false in USD: one-sided copies of the materials"
+    );
+    let tri_mesh = scene
+        .instances
+        .iter()
+        .find(|i| i.source == "/World/Tri")
+        .unwrap()
+        .mesh;
+    let tri_material = &scene.materials[scene.meshes[tri_mesh].material];
+    assert!(tri_material.double_sided && tri_material.name == "/World/Looks/Red");
+
+    // !resetXformStack! ignores the parent's translate; the stage correction still applies.
+    let lifted = world_triangles(scene, "/World/Reset/Lifted");
+    assert!(
+        close(lifted[0][0], Vec3::new(0.0, 0.5, 0.0)),
+        "{:?}",
+        lifted[0]
+    );
+    // rotateXYZ, scale, then a translate and its !invert! (which cancel): a stage point
+    // (10, 0, 0) is scaled to (20, 0, 0) and turned 90° about Z to (0, 20, 0), then the
+    // parent's translate adds (100, 0, 0): (100, 20, 0) cm → (1, 0, −0.2) m.
+    let turned = world_triangles(scene, "/World/Ops/Turned");
+    assert!(
+        close(turned[0][0], Vec3::new(1.0, 0.0, -0.2)),
+        "{:?}",
+        turned[0]
+    );
+
+    // Materials map as glTF's do.
+    let kind = |name: &str| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap_or_else(|| panic!("{name}"))
+            .clone()
+    };
+    assert_eq!(
+        kind("/World/Looks/Red").kind,
+        MaterialKind::Diffuse {
+            albedo: Vec3::new(0.8, 0.1, 0.1)
+        }
+    );
+    assert!(matches!(
+        kind("/World/Looks/Mirror").kind,
+        MaterialKind::Mirror { .. }
+    ));
+    assert_eq!(
+        kind("/World/Looks/Glass").kind,
+        MaterialKind::Glass {
+            ior: 1.33,
+            tint: Vec3::ONE
+        }
+    );
+    assert_eq!(kind("/World/Looks/Emit").emission, Vec3::new(5.0, 4.0, 3.0));
+
+    // Camera: 50 mm over a 24 mm aperture, near plane 10 cm.
+    let camera = &scene.cameras[0];
+    match camera.projection {
+        Projection::Perspective { yfov, aspect_ratio } => {
+            assert!((yfov - 2.0 * (12.0f32 / 50.0).atan()).abs() < 1e-6);
+            assert_eq!(aspect_ratio, Some(1.5));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!((camera.znear - 0.1).abs() < 1e-6);
+    assert_eq!(camera.name, "/World/Cam");
+
+    // Lights. The rect light is an emitter of radiance intensity × 2^exposure / area
+    // (normalized), 2 m × 1 m after the unit change.
+    let panel = scene
+        .materials
+        .iter()
+        .find(|m| m.name == "/World/Panel")
+        .unwrap();
+    assert!(
+        close(panel.emission, Vec3::splat(10.0 * 2.0 / 2.0)),
+        "{}",
+        panel.emission
+    );
+    assert!(!panel.double_sided);
+    let bulb = scene
+        .lights
+        .iter()
+        .find(|l| l.name == "/World/Bulb")
+        .unwrap();
+    match bulb.kind {
+        // Normalized sphere: intensity / 4 per steradian.
+        LightKind::Point {
+            position,
+            intensity,
+            ..
+        } => {
+            assert!(close(position, Vec3::new(1.0, 0.0, 0.0)));
+            assert!(close(intensity, Vec3::new(2.0, 1.0, 0.5)), "{intensity}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let sun = scene
+        .lights
+        .iter()
+        .find(|l| l.name == "/World/Sun")
+        .unwrap();
+    match sun.kind {
+        // −Z of a Z-up stage is world −Y: straight down.
+        LightKind::Directional {
+            direction,
+            irradiance,
+        } => {
+            assert!(close(direction, Vec3::NEG_Y), "{direction}");
+            assert!(close(irradiance, Vec3::splat(3.0)));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(warnings.contains("/World/Sky: DomeLight"), "{warnings}");
+}
+
+#[test]
+fn broken_usd_files_give_one_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let garbage = dir.path().join("garbage.usda");
+    std::fs::write(
+        &garbage,
+        "#usda 1.0\ndef Mesh \"M\" { int[] faceVertexCounts = [3 }",
+    )
+    .unwrap();
+    let err = load_scene(&garbage).unwrap_err().to_string();
+    assert!(err.contains("garbage.usda"), "{err}");
+
+    let bad_index = dir.path().join("bad_index.usda");
+    std::fs::write(
+        &bad_index,
+        "#usda 1.0\ndef Mesh \"M\"\n{\n    int[] faceVertexCounts = [3]\n    int[] faceVertexIndices = [0, 1, 7]\n    point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]\n}\n",
+    )
+    .unwrap();
+    let err = load_scene(&bad_index).unwrap_err();
+    assert!(matches!(err, LoadError::Invalid { .. }), "{err}");
+    let message = err.to_string();
+    assert!(
+        message.contains("bad_index.usda") && message.contains("/M") && message.contains("7"),
+        "{message}"
+    );
+
+    let missing = load_scene(&dir.path().join("missing.usdc"))
+        .unwrap_err()
+        .to_string();
+    assert!(missing.contains("missing.usdc"), "{missing}");
+}
