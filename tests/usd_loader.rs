@@ -19,6 +19,15 @@ fn blender_cornell_box_from_usdc_renders_like_the_glb() {
     check_agreement("cornell_box.usdc vs cornell_box.glb", &usd, &gltf);
 }
 
+/// Blender's point, spot and sun lights and an emissive panel through both exporters: the USD
+/// intensities (W/π for points and spots, W/4 for the sun) must give the glTF ones' image.
+#[test]
+fn blender_lights_from_usdc_render_like_the_glb() {
+    let usd = render_halves(Path::new("tests/scenes/punctual_lights.usdc"), 256, 11);
+    let gltf = render_halves(Path::new("tests/scenes/punctual_lights.glb"), 256, 21);
+    check_agreement("punctual_lights.usdc vs punctual_lights.glb", &usd, &gltf);
+}
+
 const STAGE: &str = r#"#usda 1.0
 (
     upAxis = "Z"

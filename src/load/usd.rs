@@ -49,8 +49,19 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
         materials: HashMap::new(),
         default_material: None,
         one_sided: HashMap::new(),
+        from_blender: false,
         warnings: Vec::new(),
     };
+    // Blender signs its exports in the layer's `doc` ("Blender v5.0.1").
+    loader.from_blender = loader
+        .stage
+        .stage_metadata("documentation")
+        .ok()
+        .flatten()
+        .or_else(|| loader.stage.stage_metadata("doc").ok().flatten())
+        .as_ref()
+        .and_then(as_token)
+        .is_some_and(|doc| doc.starts_with("Blender"));
     let root = loader.stage_correction();
     let roots = loader
         .stage
@@ -77,6 +88,8 @@ struct UsdLoader {
     default_material: Option<usize>,
     /// One-sided copies of materials, by the original's index.
     one_sided: HashMap<usize, usize>,
+    /// True for files Blender wrote, whose sun strengths follow Blender's convention.
+    from_blender: bool,
     warnings: Vec<String>,
 }
 
@@ -742,14 +755,18 @@ impl UsdLoader {
             .as_ref()
             .and_then(as_bool)
             .unwrap_or(false);
-        if self
+        // Blender enables colour temperature at USD's default 6500 K, which UsdLux's
+        // blackbody table makes (close to) white: taken as white; other temperatures warn.
+        let temperature = self
+            .get_f32(prim, "inputs:colorTemperature")
+            .unwrap_or(6500.0);
+        let tinted = self
             .get(prim, "inputs:enableColorTemperature")
             .as_ref()
-            .and_then(as_bool)
-            == Some(true)
-        {
+            .and_then(as_bool);
+        if tinted == Some(true) && (temperature - 6500.0).abs() > 1.0 {
             self.warn(format!(
-                "{where_}: colour temperature is not supported; using the colour alone"
+                "{where_}: colour temperature {temperature} K is not supported; using the colour alone"
             ));
         }
         let strength = colour * intensity * exposure.exp2();
@@ -859,11 +876,18 @@ impl UsdLoader {
             }
             "DistantLight" => {
                 let direction = transform.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+                // Irradiance is intensity × 2^exposure × colour, except from Blender, whose
+                // exporter writes a sun of S W/m² as intensity S/4 (and reads it back × 4).
+                let irradiance = if self.from_blender {
+                    4.0 * strength
+                } else {
+                    strength
+                };
                 self.builder.add_light(Light {
                     name: where_.clone(),
                     kind: LightKind::Directional {
                         direction,
-                        irradiance: strength,
+                        irradiance,
                     },
                     source: where_,
                 });

@@ -280,6 +280,9 @@ def build_material_details(scene):
     sphere("MetalBall", rough, 0.5, (1.5, 0.0, 0.5))
 
 
+# Scenes also exported through Blender's USD exporter, to check that both exports render alike.
+USD_EXPORTS = {"punctual_lights"}
+
 # name -> (builder, directory of the exported .glb, total reference samples; 0: export only)
 SCENE_TABLE = {
     "cornell_box": (build_cornell_box, os.path.join(ROOT, "assets"), 8192),
@@ -445,6 +448,10 @@ def main():
         build(scene)
         if not args.no_export:
             export(os.path.join(directory, f"{name}.glb"), lights=bool(bpy.data.lights))
+            if name in USD_EXPORTS:
+                path = os.path.join(directory, f"{name}.usdc")
+                bpy.ops.wm.usd_export(filepath=path)
+                print(f"wrote {path} ({os.path.getsize(path)} bytes)")
         for mat in bpy.data.materials:
             if mat.node_tree and mat.node_tree.nodes.get("Principled BSDF"):
                 use_exact_models(mat)
