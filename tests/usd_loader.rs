@@ -458,3 +458,64 @@ fn broken_usd_files_give_one_clear_error() {
         .to_string();
     assert!(missing.contains("missing.usdc"), "{missing}");
 }
+
+/// The same Blender export packaged as `.usdz` loads the same scene.
+#[test]
+fn usdz_packages_load_like_their_usdc() {
+    let usdz = load_scene(Path::new("tests/scenes/cornell_box.usdz")).unwrap();
+    let usdc = load_scene(Path::new("assets/cornell_box.usdc")).unwrap();
+    assert!(usdz.warnings.is_empty(), "{:?}", usdz.warnings);
+    assert_eq!(
+        usdz.scene.instanced_triangle_count(),
+        usdc.scene.instanced_triangle_count()
+    );
+    assert_eq!(usdz.scene.bounds(), usdc.scene.bounds());
+    let sorted = |scene: &Scene| {
+        let mut m = scene.materials.clone();
+        m.sort_by(|a, b| a.name.cmp(&b.name));
+        m
+    };
+    assert_eq!(sorted(&usdz.scene), sorted(&usdc.scene));
+    assert_eq!(usdz.scene.cameras.len(), 1);
+}
+
+/// References pull a prim in from another file; an instanceable reference shares its
+/// prototype: both place the referenced triangle under their own transform.
+#[test]
+fn references_and_instances_are_composed() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("part.usda"),
+        "#usda 1.0\n(\n    upAxis = \"Y\"\n    metersPerUnit = 1\n)\n\
+         def Xform \"Part\"\n{\n    def Mesh \"Tri\"\n    {\n        int[] faceVertexCounts = [3]\n        \
+         int[] faceVertexIndices = [0, 1, 2]\n        point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]\n        \
+         uniform bool doubleSided = 1\n    }\n}\n",
+    )
+    .unwrap();
+    let main = dir.path().join("main.usda");
+    std::fs::write(
+        &main,
+        "#usda 1.0\n(\n    upAxis = \"Y\"\n    metersPerUnit = 1\n)\n\
+         def Xform \"A\" (\n    references = @./part.usda@</Part>\n)\n{\n    \
+         double3 xformOp:translate = (5, 0, 0)\n    uniform token[] xformOpOrder = [\"xformOp:translate\"]\n}\n\
+         def Xform \"B\" (\n    instanceable = true\n    references = @./part.usda@</Part>\n)\n{\n    \
+         double3 xformOp:translate = (0, 7, 0)\n    uniform token[] xformOpOrder = [\"xformOp:translate\"]\n}\n",
+    )
+    .unwrap();
+    let loaded = load_scene(&main).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let scene = &loaded.scene;
+    let mut origins: Vec<Vec3> = scene
+        .instances
+        .iter()
+        .map(|i| {
+            i.world_from_object
+                .transform_point3(scene.meshes[i.mesh].positions[0])
+        })
+        .collect();
+    origins.sort_by(|a, b| a.x.total_cmp(&b.x));
+    assert_eq!(
+        origins,
+        vec![Vec3::new(0.0, 7.0, 0.0), Vec3::new(5.0, 0.0, 0.0)]
+    );
+}

@@ -5,8 +5,8 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
     pip install bpy==5.0.1
     python3 tools/blender/make_cornell.py
 
-Writes `assets/cornell_box.glb` (two diffuse boxes, also as `assets/cornell_box.usdc` through
-Blender's USD exporter) and `assets/cornell_spheres.glb` (a mirror sphere and a glass sphere). Blender is Z-up; the exporter converts to glTF's Y-up.
+Writes `assets/cornell_box.glb` (two diffuse boxes, also as `assets/cornell_box.usdc` and
+`tests/scenes/cornell_box.usdz` through Blender's USD exporter) and `assets/cornell_spheres.glb` (a mirror sphere and a glass sphere). Blender is Z-up; the exporter converts to glTF's Y-up.
 The wall colours are the usual Cornell box reflectances; the light is an emissive quad that
 fills an opening in the ceiling, exported through KHR_materials_emissive_strength.
 """
@@ -19,6 +19,7 @@ import bpy
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ASSETS = os.path.join(ROOT, "assets")
+TEST_SCENES = os.path.join(ROOT, "tests", "scenes")
 
 WHITE = (0.725, 0.71, 0.68)
 RED = (0.63, 0.065, 0.05)
@@ -160,9 +161,9 @@ def main():
             # The same scene through Blender's USD exporter (Z-up, metres). The spheres scene
             # is not exported: Blender's USD exporter writes no transmission, so its glass
             # would arrive opaque.
-            path = os.path.join(ASSETS, f"{name}.usdc")
-            bpy.ops.wm.usd_export(filepath=path)
-            print(f"wrote {path} ({os.path.getsize(path)} bytes)")
+            for path in (os.path.join(ASSETS, f"{name}.usdc"), os.path.join(TEST_SCENES, f"{name}.usdz")):
+                bpy.ops.wm.usd_export(filepath=path)
+                print(f"wrote {path} ({os.path.getsize(path)} bytes)")
     return 0
 
 
