@@ -11,12 +11,14 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use glam::{Affine3A, Mat4, Vec2, Vec3};
+use glam::{Affine2, Affine3A, Mat4, Vec2, Vec3};
 use openusd::{sdf, usd};
 
+use super::tangents::generate_tangents;
 use super::{LoadError, Loaded};
 use crate::scene::{
-    Camera, Light, LightKind, Material, MaterialKind, Mesh, Projection, SceneBuilder,
+    AlphaMode, Camera, ColorSpace, Light, LightKind, Material, MaterialKind, MaterialTextures,
+    Mesh, Projection, SceneBuilder, Texture, TextureRef, Wrap,
 };
 
 /// Deepest prim hierarchy walked.
@@ -49,6 +51,7 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
         materials: HashMap::new(),
         default_material: None,
         one_sided: HashMap::new(),
+        textures: HashMap::new(),
         from_blender: false,
         warnings: Vec::new(),
     };
@@ -88,6 +91,8 @@ struct UsdLoader {
     default_material: Option<usize>,
     /// One-sided copies of materials, by the original's index.
     one_sided: HashMap<usize, usize>,
+    /// Our texture for each image file tried (`None`: unreadable).
+    textures: HashMap<String, Option<usize>>,
     /// True for files Blender wrote, whose sun strengths follow Blender's convention.
     from_blender: bool,
     warnings: Vec<String>,
@@ -563,6 +568,18 @@ impl UsdLoader {
             if !double_sided {
                 mesh.material = self.one_sided(material);
             }
+            if self
+                .builder
+                .material_mut(material)
+                .textures
+                .normal
+                .is_some()
+                && !generate_tangents(&mut mesh, 0)
+            {
+                self.warn(format!(
+                    "{where_}: a normal map needs primvars:st, which is missing; ignored here"
+                ));
+            }
             let index = self.builder.add_full_mesh(mesh);
             self.builder.add_instance(index, transform, where_.clone());
         }
@@ -642,24 +659,60 @@ impl UsdLoader {
             ));
             return Material::diffuse(name, Vec3::splat(0.8));
         }
-        let colour = |loader: &mut UsdLoader, input: &str, default: Vec3| {
-            loader.warn_if_connected(&shader, input, &name);
-            loader
-                .get(&shader, input)
-                .as_ref()
-                .and_then(as_vec3)
-                .unwrap_or(default)
+        let mut textures = MaterialTextures {
+            metallic_factor: 0.0,
+            normal_scale: 1.0,
+            ..MaterialTextures::default()
         };
-        let scalar = |loader: &mut UsdLoader, input: &str, default: f32| {
-            loader.warn_if_connected(&shader, input, &name);
-            loader.get_f32(&shader, input).unwrap_or(default)
-        };
-        let diffuse = colour(self, "inputs:diffuseColor", Vec3::splat(0.18));
-        let emission = colour(self, "inputs:emissiveColor", Vec3::ZERO);
-        let metallic = scalar(self, "inputs:metallic", 0.0);
-        let opacity = scalar(self, "inputs:opacity", 1.0);
-        let ior = scalar(self, "inputs:ior", 1.5);
-        let roughness = scalar(self, "inputs:roughness", 0.5);
+        // A connected input is a texture (its scale as the factor); else a constant.
+        let diffuse =
+            match self.texture_input(&shader, "inputs:diffuseColor", ColorSpace::Srgb, &name) {
+                Some((r, scale)) => {
+                    textures.base_colour = Some(r);
+                    scale
+                }
+                None => self.constant_colour(&shader, "inputs:diffuseColor", Vec3::splat(0.18)),
+            };
+        let emission =
+            match self.texture_input(&shader, "inputs:emissiveColor", ColorSpace::Srgb, &name) {
+                Some((r, scale)) => {
+                    textures.emissive = Some(r);
+                    scale
+                }
+                None => self.constant_colour(&shader, "inputs:emissiveColor", Vec3::ZERO),
+            };
+        if let Some((r, _)) =
+            self.texture_input(&shader, "inputs:normal", ColorSpace::Linear, &name)
+        {
+            textures.normal = Some(r);
+        }
+        let mut alpha_mode = AlphaMode::Opaque;
+        let mut opacity = self.get_f32(&shader, "inputs:opacity").unwrap_or(1.0);
+        if let Some((r, _)) =
+            self.texture_input(&shader, "inputs:opacity", ColorSpace::Linear, &name)
+        {
+            // Opacity from a texture's alpha (Blender's wiring) cuts out at the threshold,
+            // or blends without one. The base-colour texture carries that alpha here.
+            if textures.base_colour.is_none_or(|b| b.texture == r.texture) {
+                textures.base_colour.get_or_insert(r);
+                let threshold = self
+                    .get_f32(&shader, "inputs:opacityThreshold")
+                    .unwrap_or(0.0);
+                alpha_mode = if threshold > 0.0 {
+                    AlphaMode::Mask { cutoff: threshold }
+                } else {
+                    AlphaMode::Blend
+                };
+            } else {
+                self.warn(format!(
+                    "{name}: opacity from a texture other than the diffuse one is not supported"
+                ));
+            }
+            opacity = 1.0;
+        }
+        let metallic = self.constant_scalar(&shader, "inputs:metallic", 0.0, &name);
+        let ior = self.constant_scalar(&shader, "inputs:ior", 1.5, &name);
+        let roughness = self.constant_scalar(&shader, "inputs:roughness", 0.5, &name);
         let kind = if opacity < 0.5 {
             MaterialKind::Glass { ior, tint: diffuse }
         } else if metallic >= 0.5 {
@@ -676,8 +729,145 @@ impl UsdLoader {
         }
         Material {
             emission,
+            textures,
+            alpha_mode,
             ..Material::new(name, kind)
         }
+    }
+
+    fn constant_colour(&mut self, shader: &sdf::Path, input: &str, default: Vec3) -> Vec3 {
+        self.get(shader, input)
+            .as_ref()
+            .and_then(as_vec3)
+            .unwrap_or(default)
+    }
+
+    fn constant_scalar(
+        &mut self,
+        shader: &sdf::Path,
+        input: &str,
+        default: f32,
+        material: &str,
+    ) -> f32 {
+        self.warn_if_connected(shader, input, material);
+        self.get_f32(shader, input).unwrap_or(default)
+    }
+
+    /// The `UsdUVTexture` feeding `input`, as a texture reference and the colour factor its
+    /// `scale` gives; `None` when the input is not connected (or cannot be used, with a
+    /// warning). The texture's `st` may pass through a `UsdTransform2d` and comes from a
+    /// `UsdPrimvarReader_float2` of `st` (the set the loader reads).
+    fn texture_input(
+        &mut self,
+        shader: &sdf::Path,
+        input: &str,
+        space: ColorSpace,
+        material: &str,
+    ) -> Option<(TextureRef, Vec3)> {
+        let source = shader
+            .append_property(input)
+            .ok()
+            .and_then(|p| self.stage.attribute(p).connections().ok())
+            .and_then(|c| c.into_iter().next())?;
+        let node = source.prim_path();
+        if self.get_token(&node, "info:id").as_deref() != Some("UsdUVTexture") {
+            self.warn(format!(
+                "{material}: {input} is connected to something other than a UsdUVTexture; ignored"
+            ));
+            return None;
+        }
+        let file = match self.get(&node, "inputs:file") {
+            Some(sdf::Value::AssetPath(a)) => a.authored_path.clone(),
+            _ => {
+                self.warn(format!(
+                    "{material}: {input}'s texture has no file; ignored"
+                ));
+                return None;
+            }
+        };
+        let texture = self.texture_file(&file, material)?;
+        if matches!(space, ColorSpace::Srgb)
+            && self.get_token(&node, "inputs:sourceColorSpace").as_deref() == Some("raw")
+        {
+            self.warn(format!(
+                "{material}: {input} reads '{file}' as raw data; treated as sRGB colour"
+            ));
+        }
+        let scale = match self.get(&node, "inputs:scale") {
+            Some(sdf::Value::Vec4f(v)) => Vec3::new(v.x, v.y, v.z),
+            _ => Vec3::ONE,
+        };
+        let wrap = |mode: Option<String>| match mode.as_deref() {
+            Some("clamp") => Wrap::ClampToEdge,
+            Some("mirror") => Wrap::MirroredRepeat,
+            _ => Wrap::Repeat,
+        };
+        let mut reference = TextureRef::new(texture);
+        reference.wrap_u = wrap(self.get_token(&node, "inputs:wrapS"));
+        reference.wrap_v = wrap(self.get_token(&node, "inputs:wrapT"));
+        // USD's st has v up the image, ours down: uv → st → UsdTransform2d → uv.
+        let flip = Affine2::from_cols(Vec2::X, Vec2::NEG_Y, Vec2::Y);
+        let st = node
+            .append_property("inputs:st")
+            .ok()
+            .and_then(|p| self.stage.attribute(p).connections().ok())
+            .and_then(|c| c.into_iter().next())
+            .map(|p| p.prim_path());
+        if let Some(st) = st
+            && self.get_token(&st, "info:id").as_deref() == Some("UsdTransform2d")
+        {
+            let scale = match self.get(&st, "inputs:scale") {
+                Some(sdf::Value::Vec2f(v)) => Vec2::new(v.x, v.y),
+                _ => Vec2::ONE,
+            };
+            let translation = match self.get(&st, "inputs:translation") {
+                Some(sdf::Value::Vec2f(v)) => Vec2::new(v.x, v.y),
+                _ => Vec2::ZERO,
+            };
+            let rotation = self
+                .get_f32(&st, "inputs:rotation")
+                .unwrap_or(0.0)
+                .to_radians();
+            let transform = Affine2::from_scale_angle_translation(scale, rotation, translation);
+            reference.transform = flip * transform * flip;
+        }
+        let factor = if matches!(space, ColorSpace::Srgb) {
+            scale
+        } else {
+            Vec3::ONE
+        };
+        Some((reference, factor))
+    }
+
+    /// The scene texture of an image file relative to the stage, decoded once.
+    fn texture_file(&mut self, file: &str, material: &str) -> Option<usize> {
+        if let Some(&known) = self.textures.get(file) {
+            return known;
+        }
+        let base = self.path.parent().unwrap_or(Path::new("."));
+        let full = base.join(file);
+        let decoded = match image::open(&full) {
+            Ok(image) => {
+                let rgba = image.to_rgba16();
+                let (width, height) = rgba.dimensions();
+                let texels = rgba.pixels().map(|p| p.0).collect();
+                Some(self.builder.add_texture(Texture {
+                    name: file.to_string(),
+                    width,
+                    height,
+                    texels,
+                }))
+            }
+            Err(e) => {
+                self.warn(format!(
+                    "{material}: texture {} cannot be read ({e}); using a neutral texture",
+                    full.display()
+                ));
+                None
+            }
+        };
+        self.textures.insert(file.to_string(), decoded);
+        decoded
     }
 
     /// Textures and other networks feeding an input are not read yet: say so.

@@ -207,13 +207,17 @@ pub fn write_difference_images(name: &str, gridtrace: &Halves, reference: &Halve
 pub fn render_halves(path: &Path, spp: u32, first_seed: u64) -> Halves {
     let loaded = load_scene(path).unwrap();
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
-    let scene = loaded.scene;
+    render_scene_halves(&loaded.scene, spp, first_seed)
+}
+
+/// Renders `scene` through its first camera in two halves, as [`render_halves`].
+pub fn render_scene_halves(scene: &gridtrace::scene::Scene, spp: u32, first_seed: u64) -> Halves {
     let camera = scene
         .cameras
         .first()
         .expect("the scene has a camera")
         .clone();
-    let renderer = Renderer::new(&scene);
+    let renderer = Renderer::new(scene);
     Halves {
         a: render(&renderer, &camera, spp / 2, first_seed),
         b: render(&renderer, &camera, spp / 2, first_seed + 1),
