@@ -667,3 +667,28 @@ fn a_constant_normal_map_tilts_the_shading_normal() {
         );
     }
 }
+
+/// A convex Lambertian polyhedron (a flat-shaded sphere) under a uniform environment of
+/// radiance L receives E = πL at every point and sees nothing else, so it shows ρ·L; rays
+/// that miss see L.
+#[test]
+fn a_diffuse_sphere_under_a_uniform_sky_shows_albedo_times_sky() {
+    let (albedo, sky) = (0.6f32, Vec3::new(1.0, 2.0, 0.5));
+    let mut b = SceneBuilder::new();
+    let white = b.add_material(Material::diffuse("ball", Vec3::splat(albedo)));
+    add_sphere(&mut b, Vec3::ZERO, 1.0, white);
+    b.add_environment(sky);
+    let mut scene = b.build();
+    // Flat facets: with interpolated normals a cosine lobe around the shading normal pokes
+    // below the facet, and the true answer is a little under ρ·L.
+    scene.meshes[0].normals.clear();
+    for strategy in STRATEGIES {
+        let on_ball = Ray::new(Vec3::new(0.2, 0.1, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        let expected = (sky * albedo).as_dvec3();
+        let on_ball = estimate(&scene, on_ball, strategy, 100_000);
+        assert_matches(&format!("ball, {strategy:?}"), on_ball, expected, 0.01);
+        let past = Ray::new(Vec3::new(3.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        let (mean, _) = estimate(&scene, past, strategy, 4);
+        assert_eq!(mean, sky.as_dvec3(), "{strategy:?}");
+    }
+}

@@ -188,6 +188,8 @@ def Xform "World"
 
     def DomeLight "Sky"
     {
+        float inputs:intensity = 0.5
+        color3f inputs:color = (1, 0.5, 0.25)
     }
 
     def Sphere "Ball"
@@ -447,7 +449,11 @@ fn a_hand_written_stage_loads_as_usd_defines_it() {
         }
         other => panic!("{other:?}"),
     }
-    assert!(warnings.contains("/World/Sky: DomeLight"), "{warnings}");
+    assert!(
+        close(scene.environment, Vec3::new(0.5, 0.25, 0.125)),
+        "{}",
+        scene.environment
+    );
 }
 
 #[test]

@@ -325,9 +325,7 @@ impl UsdLoader {
             "RectLight" | "DiskLight" | "SphereLight" | "DistantLight" => {
                 self.add_light(&path, &type_name, world)
             }
-            "DomeLight" => self.warn(format!(
-                "{where_}: DomeLight (environment lighting) is not supported yet; ignored"
-            )),
+            "DomeLight" => self.add_dome(&path),
             "" | "Xform" | "Scope" | "SkelRoot" => {}
             "Sphere" | "Cube" | "Cylinder" | "Cone" | "Capsule" | "Plane" | "Points"
             | "BasisCurves" | "NurbsCurves" | "NurbsPatch" | "PointInstancer" | "Volume" => self
@@ -880,6 +878,32 @@ impl UsdLoader {
         if connected {
             self.warn(format!(
                 "{material}: {input} is connected to a shader network (textures are not read from USD yet); using its constant value"
+            ));
+        }
+    }
+
+    /// A `DomeLight` of constant colour: radiance intensity × 2^exposure × color from every
+    /// direction the scene leaves open. A texture (an environment map) is not read.
+    fn add_dome(&mut self, prim: &sdf::Path) {
+        let where_ = prim.as_str();
+        let intensity = self.get_f32(prim, "inputs:intensity").unwrap_or(1.0);
+        let exposure = self.get_f32(prim, "inputs:exposure").unwrap_or(0.0);
+        let colour = self
+            .get(prim, "inputs:color")
+            .as_ref()
+            .and_then(as_vec3)
+            .unwrap_or(Vec3::ONE);
+        if self.get(prim, "inputs:texture:file").is_some() {
+            self.warn(format!(
+                "{where_}: DomeLight texture maps are not supported; using its constant colour"
+            ));
+        }
+        let radiance = colour * intensity * exposure.exp2();
+        if radiance.is_finite() && radiance.min_element() >= 0.0 {
+            self.builder.add_environment(radiance);
+        } else {
+            self.warn(format!(
+                "{where_}: negative or non-finite dome light; skipped"
             ));
         }
     }

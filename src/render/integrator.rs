@@ -77,6 +77,18 @@ impl Renderer<'_> {
         loop {
             result.rays += 1;
             let Some(hit) = self.accel.intersect(&ray) else {
+                // The path leaves the scene: the environment, weighed like any emitter.
+                let (environment, light_pdf) = self.lights.environment();
+                if environment != Vec3::ZERO {
+                    let weight = match (arrival, strategy) {
+                        (Arrival::Specular, _) | (_, Strategy::BsdfOnly) => 1.0,
+                        (Arrival::Scattered { .. }, Strategy::LightOnly) => 0.0,
+                        (Arrival::Scattered { pdf }, Strategy::Mis) => {
+                            power_heuristic(pdf, light_pdf)
+                        }
+                    };
+                    result.radiance += weight * beta * environment;
+                }
                 break;
             };
             let segment = hit.t * ray.direction.length();

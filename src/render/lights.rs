@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use glam::{Vec2, Vec3};
 
-use super::sampling::{Distribution1d, uniform_triangle};
+use super::sampling::{Distribution1d, uniform_sphere, uniform_triangle};
 use super::shading::uv_at;
 use super::surface::{interpolate_with_error, transform_point_with_error};
 use crate::scene::{ColorSpace, LightKind, Scene, TextureRef};
@@ -62,6 +62,8 @@ pub struct LightSet {
     /// beyond it, and their power is what crosses its disc.
     scene_radius: f32,
     scene_center: Vec3,
+    /// Constant radiance from directions that miss the scene.
+    environment: Vec3,
     /// For each instance, the index of its mesh's first triangle in `triangles`, if emissive.
     first_of_instance: Vec<Option<u32>>,
 }
@@ -126,6 +128,15 @@ impl LightSet {
             .iter()
             .map(|l| punctual_power(l, scene_radius))
             .collect();
+        // A constant environment sends π·L per unit area onto the scene's bounding disc from
+        // each side it is seen; what matters is that it competes fairly with the others.
+        let environment = scene.environment;
+        let environment_weight = if environment.max_element() > 0.0 {
+            let radius = scene_radius.max(1e-3);
+            PI * PI * radius * radius * environment.element_sum() / 3.0
+        } else {
+            0.0
+        };
         // A textured emitter counts with its texture's mean.
         let mut texture_means = HashMap::new();
         let weights = triangles
@@ -140,6 +151,7 @@ impl LightSet {
                 t.area * sides * PI * (t.radiance * scale).element_sum() / 3.0
             })
             .chain(punctual_weights.iter().copied())
+            .chain(std::iter::once(environment_weight))
             .collect();
         LightSet {
             triangles,
@@ -148,6 +160,7 @@ impl LightSet {
             punctual_distribution: Distribution1d::new(punctual_weights),
             scene_radius,
             scene_center,
+            environment,
             first_of_instance,
         }
     }
@@ -177,7 +190,11 @@ impl LightSet {
     pub fn sample(&self, scene: &Scene, p: Vec3, u_light: f32, u: Vec2) -> Option<LightSample> {
         let (index, pmf) = self.distribution.sample(u_light)?;
         let Some(tri) = self.triangles.get(index) else {
-            return self.sample_punctual_light(index - self.triangles.len(), pmf, p);
+            let punctual = index - self.triangles.len();
+            if punctual == self.punctual.len() {
+                return self.sample_environment(pmf, p, u);
+            }
+            return self.sample_punctual_light(punctual, pmf, p);
         };
         let b = uniform_triangle(u);
         let (point, point_error) = interpolate_with_error(tri.corners, [1.0 - b.x - b.y, b.x, b.y]);
@@ -214,6 +231,29 @@ impl LightSet {
             pdf,
             is_delta: false,
         })
+    }
+
+    /// The constant environment: a uniform direction on the sphere, from beyond the scene.
+    fn sample_environment(&self, pmf: f32, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let wi = uniform_sphere(u);
+        let far = 2.0 * self.scene_radius + p.distance(self.scene_center) + 1.0;
+        Some(LightSample {
+            point: p + far * wi,
+            point_error: Vec3::ZERO,
+            normal: -wi,
+            wi,
+            distance: far,
+            radiance: self.environment,
+            pdf: pmf / (4.0 * PI),
+            is_delta: false,
+        })
+    }
+
+    /// Radiance of the environment along a ray that left the scene, and the solid-angle
+    /// density with which [`LightSet::sample`] would have picked that direction.
+    pub fn environment(&self) -> (Vec3, f32) {
+        let index = self.triangles.len() + self.punctual.len();
+        (self.environment, self.distribution.pmf(index) / (4.0 * PI))
     }
 
     /// Draws a punctual light alone, by power, for shading point `p`.

@@ -77,6 +77,14 @@ pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
     Vec3::new(d.x, d.y, (1.0 - d.length_squared()).max(0.0).sqrt())
 }
 
+/// A direction uniform over the unit sphere, density 1/(4π) (pbrt-v3 §13.6.1).
+pub fn uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
 /// Barycentrics (b1, b2) of a uniform point on a triangle (pbrt-v3 §13.6.5).
 pub fn uniform_triangle(u: Vec2) -> Vec2 {
     let s = u.x.sqrt();

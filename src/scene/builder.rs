@@ -96,6 +96,11 @@ impl SceneBuilder {
         self.scene.textures.len() - 1
     }
 
+    /// Adds constant radiance from every direction that misses the scene.
+    pub fn add_environment(&mut self, radiance: Vec3) {
+        self.scene.environment += radiance;
+    }
+
     /// Adds a punctual light.
     pub fn add_light(&mut self, light: Light) {
         self.scene.lights.push(light);

@@ -118,6 +118,9 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Decoded images, indexed by [`TextureRef::texture`].
     pub textures: Vec<Texture>,
+    /// Radiance arriving from every direction no geometry covers (a constant dome light);
+    /// zero: black.
+    pub environment: Vec3,
 }
 
 impl Scene {
@@ -135,6 +138,7 @@ impl Scene {
     /// True when some instanced mesh has an emissive material or there is a punctual light.
     pub fn has_emitters(&self) -> bool {
         !self.lights.is_empty()
+            || self.environment.max_element() > 0.0
             || self.instances.iter().any(|inst| {
                 let mesh = &self.meshes[inst.mesh];
                 self.materials[mesh.material].is_emissive() && !mesh.indices.is_empty()
