@@ -186,6 +186,58 @@ def Xform "World"
         float inputs:intensity = 3
     }
 
+    def DiskLight "Disk"
+    {
+        float inputs:intensity = 2
+        float inputs:radius = 50
+    }
+
+    def SphereLight "WarmSpot" (
+        prepend apiSchemas = ["ShapingAPI"]
+    )
+    {
+        float inputs:intensity = 4
+        bool inputs:normalize = 1
+        float inputs:radius = 0
+        bool inputs:enableColorTemperature = 1
+        float inputs:colorTemperature = 3000
+        float inputs:shaping:cone:angle = 30
+        float inputs:shaping:cone:softness = 0.5
+    }
+
+    def Xform "Variant" (
+        variants = {
+            string size = "big"
+        }
+        prepend variantSets = "size"
+    )
+    {
+        variantSet "size" = {
+            "big" {
+                def Mesh "Chosen"
+                {
+                    int[] faceVertexCounts = [3]
+                    int[] faceVertexIndices = [0, 1, 2]
+                    point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+                }
+            }
+            "small" {
+                def Mesh "NotChosen"
+                {
+                    int[] faceVertexCounts = [3]
+                    int[] faceVertexIndices = [0, 1, 2]
+                    point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+                }
+            }
+        }
+    }
+
+    def Xform "Payloaded" (
+        payload = @./part.usda@</Part>
+    )
+    {
+    }
+
     def DomeLight "Sky"
     {
         float inputs:intensity = 0.5
@@ -248,6 +300,24 @@ def Xform "World"
 }
 "#;
 
+/// A file other stages reference, pull in as a payload or instance.
+const PART: &str = r#"#usda 1.0
+(
+    upAxis = "Y"
+    metersPerUnit = 1
+)
+def Xform "Part"
+{
+    def Mesh "Tri"
+    {
+        int[] faceVertexCounts = [3]
+        int[] faceVertexIndices = [0, 1, 2]
+        point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+        uniform bool doubleSided = 1
+    }
+}
+"#;
+
 /// World-space corners of each instanced triangle of the instance named `source`.
 fn world_triangles(scene: &Scene, source: &str) -> Vec<[Vec3; 3]> {
     scene
@@ -275,6 +345,7 @@ fn a_hand_written_stage_loads_as_usd_defines_it() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("stage.usda");
     std::fs::write(&path, STAGE).unwrap();
+    std::fs::write(dir.path().join("part.usda"), PART).unwrap();
     let loaded = load_scene(&path).unwrap();
     let scene = &loaded.scene;
     let warnings = loaded.warnings.join("\n");
@@ -454,6 +525,41 @@ fn a_hand_written_stage_loads_as_usd_defines_it() {
         "{}",
         scene.environment
     );
+    // A disk of radius 50 cm, not normalized: radiance = intensity, area ≈ π/4 m².
+    let disk = world_triangles(scene, "/World/Disk");
+    let area: f32 = disk
+        .iter()
+        .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
+        .sum();
+    assert!((area - std::f32::consts::PI / 4.0).abs() < 0.01, "{area}");
+    let disk_material = scene.materials.iter().find(|m| m.name == "/World/Disk");
+    assert_eq!(disk_material.unwrap().emission, Vec3::splat(2.0));
+    let warm = scene
+        .lights
+        .iter()
+        .find(|l| l.name == "/World/WarmSpot")
+        .unwrap();
+    match warm.kind {
+        // Softness 0.5 of a 30° cone: full inside 15°; 3000 K is warm.
+        LightKind::Spot {
+            intensity,
+            cos_inner,
+            cos_outer,
+            ..
+        } => {
+            assert!((cos_outer - 30f32.to_radians().cos()).abs() < 1e-6);
+            assert!((cos_inner - 15f32.to_radians().cos()).abs() < 1e-6);
+            assert!(
+                intensity.x > intensity.y && intensity.y > intensity.z,
+                "{intensity}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // The selected variant and the payload are composed in; the other variant is not.
+    assert_eq!(world_triangles(scene, "/World/Variant/Chosen").len(), 1);
+    assert!(world_triangles(scene, "/World/Variant/NotChosen").is_empty());
+    assert_eq!(world_triangles(scene, "/World/Payloaded/Tri").len(), 1);
 }
 
 #[test]
@@ -513,14 +619,7 @@ fn usdz_packages_load_like_their_usdc() {
 #[test]
 fn references_and_instances_are_composed() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("part.usda"),
-        "#usda 1.0\n(\n    upAxis = \"Y\"\n    metersPerUnit = 1\n)\n\
-         def Xform \"Part\"\n{\n    def Mesh \"Tri\"\n    {\n        int[] faceVertexCounts = [3]\n        \
-         int[] faceVertexIndices = [0, 1, 2]\n        point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]\n        \
-         uniform bool doubleSided = 1\n    }\n}\n",
-    )
-    .unwrap();
+    std::fs::write(dir.path().join("part.usda"), PART).unwrap();
     let main = dir.path().join("main.usda");
     std::fs::write(
         &main,

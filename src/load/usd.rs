@@ -969,20 +969,20 @@ impl UsdLoader {
             .as_ref()
             .and_then(as_bool)
             .unwrap_or(false);
-        // Blender enables colour temperature at USD's default 6500 K, which UsdLux's
-        // blackbody table makes (close to) white: taken as white; other temperatures warn.
-        let temperature = self
-            .get_f32(prim, "inputs:colorTemperature")
-            .unwrap_or(6500.0);
-        let tinted = self
+        // Colour temperature tints relative to 6500 K, USD's default white point, which
+        // Blender writes on every light and Cycles renders white.
+        let enabled = self
             .get(prim, "inputs:enableColorTemperature")
             .as_ref()
             .and_then(as_bool);
-        if tinted == Some(true) && (temperature - 6500.0).abs() > 1.0 {
-            self.warn(format!(
-                "{where_}: colour temperature {temperature} K is not supported; using the colour alone"
-            ));
-        }
+        let colour = if enabled == Some(true) {
+            let kelvin = self
+                .get_f32(prim, "inputs:colorTemperature")
+                .unwrap_or(6500.0);
+            colour * blackbody_tint(kelvin)
+        } else {
+            colour
+        };
         let strength = colour * intensity * exposure.exp2();
         if !strength.is_finite() || strength.min_element() < 0.0 {
             self.warn(format!(
@@ -1111,6 +1111,39 @@ impl UsdLoader {
     }
 }
 
+/// The colour of a blackbody at `kelvin` (clamped to 1667–25000 K) relative to one at
+/// 6500 K, in linear sRGB: the Planckian locus approximation of Kim et al. (2002) gives its
+/// chromaticity, the sRGB matrix (IEC 61966-2-1) its colour at unit luminance.
+fn blackbody_tint(kelvin: f32) -> Vec3 {
+    fn rgb(kelvin: f64) -> Vec3 {
+        let t = kelvin.clamp(1667.0, 25000.0);
+        let (t2, t3) = (t * t, t * t * t);
+        let x = if t <= 4000.0 {
+            -0.2661239e9 / t3 - 0.2343589e6 / t2 + 0.8776956e3 / t + 0.179910
+        } else {
+            -3.0258469e9 / t3 + 2.1070379e6 / t2 + 0.2226347e3 / t + 0.240390
+        };
+        let y = if t <= 2222.0 {
+            -1.1063814 * x * x * x - 1.34811020 * x * x + 2.18555832 * x - 0.20219683
+        } else if t <= 4000.0 {
+            -0.9549476 * x * x * x - 1.37418593 * x * x + 2.09137015 * x - 0.16748867
+        } else {
+            3.0817580 * x * x * x - 5.87338670 * x * x + 3.75112997 * x - 0.37001483
+        };
+        let (cx, cy, cz) = (x / y, 1.0, (1.0 - x - y) / y);
+        Vec3::new(
+            (3.2404542 * cx - 1.5371385 * cy - 0.4985314 * cz) as f32,
+            (-0.9692660 * cx + 1.8760108 * cy + 0.0415560 * cz) as f32,
+            (0.0556434 * cx - 0.2040259 * cy + 1.0572252 * cz) as f32,
+        )
+        .max(Vec3::ZERO)
+    }
+    if !kelvin.is_finite() {
+        return Vec3::ONE;
+    }
+    rgb(kelvin as f64) / rgb(6500.0)
+}
+
 /// Triangles (as corner positions in `polygon`) covering a planar polygon: a fan when it is
 /// convex, ear clipping (Eberly, "Triangulation by Ear Clipping", 2002) otherwise.
 fn triangulate(polygon: &[Vec3]) -> Vec<[usize; 3]> {
@@ -1178,6 +1211,15 @@ mod tests {
                 0.5 * (b - a).cross(c - a).dot(Vec3::Z)
             })
             .sum()
+    }
+
+    #[test]
+    fn colour_temperature_is_warm_below_and_cool_above_6500_kelvin() {
+        assert!((blackbody_tint(6500.0) - Vec3::ONE).abs().max_element() < 1e-6);
+        let candle = blackbody_tint(2000.0);
+        assert!(candle.x > 1.0 && candle.z < 0.3 * candle.x, "{candle}");
+        let sky = blackbody_tint(12000.0);
+        assert!(sky.z > sky.x, "{sky}");
     }
 
     #[test]
