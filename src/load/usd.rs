@@ -27,8 +27,25 @@ const MAX_DEPTH: usize = 256;
 /// Segments of the polygon a `DiskLight` becomes.
 const DISK_SEGMENTS: u32 = 48;
 
-/// Loads a USD stage.
+/// Loads a USD stage. The USD reader is young third-party code: a panic inside it becomes an
+/// error naming the file instead of taking the program down.
 pub fn load(path: &Path) -> Result<Loaded, LoadError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_stage(path))).unwrap_or_else(
+        |panic| {
+            let why = panic
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("unknown failure");
+            Err(LoadError::Invalid {
+                path: path.to_path_buf(),
+                what: format!("the USD reader failed: {why}"),
+            })
+        },
+    )
+}
+
+fn load_stage(path: &Path) -> Result<Loaded, LoadError> {
     let invalid = |what: String| LoadError::Invalid {
         path: path.to_path_buf(),
         what,
