@@ -6,6 +6,7 @@ mod image_stats;
 use std::path::Path;
 
 use glam::Vec3;
+use gridtrace::cli::choose_camera;
 use gridtrace::load::{LoadError, load_scene};
 use gridtrace::scene::{Filter, LightKind, MaterialKind, Projection, Scene};
 use image_stats::{check_agreement, render_halves, render_scene_halves};
@@ -184,6 +185,13 @@ def Xform "World"
     def DistantLight "Sun"
     {
         float inputs:intensity = 3
+    }
+
+    def SphereLight "Globe"
+    {
+        float inputs:intensity = 3
+        bool inputs:normalize = 1
+        float inputs:radius = 10
     }
 
     def DiskLight "Disk"
@@ -556,6 +564,23 @@ fn a_hand_written_stage_loads_as_usd_defines_it() {
         }
         other => panic!("{other:?}"),
     }
+    // A sphere light with a radius is a spherical emitter: normalized, its radiance is
+    // intensity over its area (radius 10 cm).
+    let globe = scene
+        .materials
+        .iter()
+        .find(|m| m.name == "/World/Globe")
+        .unwrap();
+    let expected = 3.0 / (4.0 * std::f32::consts::PI * 0.01);
+    assert!(
+        (globe.emission.x / expected - 1.0).abs() < 1e-4,
+        "{}",
+        globe.emission
+    );
+    assert_eq!(world_triangles(scene, "/World/Globe").len(), 2 * 16 * 32);
+    // `--camera` finds a USD camera by its prim path.
+    let chosen = choose_camera(scene, Some("/World/Cam"), None, None).unwrap();
+    assert_eq!(chosen.name, "/World/Cam");
     // The selected variant and the payload are composed in; the other variant is not.
     assert_eq!(world_triangles(scene, "/World/Variant/Chosen").len(), 1);
     assert!(world_triangles(scene, "/World/Variant/NotChosen").is_empty());

@@ -1061,7 +1061,21 @@ impl UsdLoader {
                 emitter(self, positions, indices, area);
             }
             "SphereLight" => {
-                let r = self.get_f32(prim, "inputs:radius").unwrap_or(0.5) * area_scale.sqrt();
+                let local_radius = self.get_f32(prim, "inputs:radius").unwrap_or(0.5);
+                let r = local_radius * area_scale.sqrt();
+                let shaped = self
+                    .get_f32(prim, "inputs:shaping:cone:angle")
+                    .is_some_and(|a| a < 180.0);
+                let as_point =
+                    self.get(prim, "treatAsPoint").as_ref().and_then(as_bool) == Some(true);
+                if !as_point && !shaped && r > 0.0 {
+                    // A real sphere: an emitter of radiance L over its surface (one-sided,
+                    // outwards), as Cycles renders a point light with a radius.
+                    let (positions, indices) = uv_sphere(local_radius);
+                    let area = 4.0 * std::f32::consts::PI * local_radius * local_radius;
+                    emitter(self, positions, indices, area);
+                    return;
+                }
                 // A sphere of radiance L emits π·L·4πr² in all, i.e. L·πr² per steradian;
                 // normalized, L = intensity / 4πr², so intensity / 4 per steradian.
                 let per_steradian = if normalize || r == 0.0 {
@@ -1069,11 +1083,9 @@ impl UsdLoader {
                 } else {
                     strength * std::f32::consts::PI * r * r
                 };
-                if self.get(prim, "treatAsPoint").as_ref().and_then(as_bool) != Some(true)
-                    && r > 0.0
-                {
+                if shaped && !as_point && r > 0.0 {
                     self.warn(format!(
-                        "{where_}: SphereLight of radius {r} is rendered as a point light"
+                        "{where_}: shaped SphereLight of radius {r} is rendered as a point spot light"
                     ));
                 }
                 let position = transform.transform_point3(Vec3::ZERO);
@@ -1126,6 +1138,36 @@ impl UsdLoader {
             _ => {}
         }
     }
+}
+
+/// A UV sphere of `radius` about the origin, wound outwards.
+fn uv_sphere(radius: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let (rings, segments) = (16u32, 32u32);
+    let mut positions = Vec::new();
+    for ring in 0..=rings {
+        let theta = std::f32::consts::PI * ring as f32 / rings as f32;
+        for segment in 0..=segments {
+            let phi = std::f32::consts::TAU * segment as f32 / segments as f32;
+            positions.push(
+                radius
+                    * Vec3::new(
+                        theta.sin() * phi.cos(),
+                        theta.sin() * phi.sin(),
+                        theta.cos(),
+                    ),
+            );
+        }
+    }
+    let row = segments + 1;
+    let mut indices = Vec::new();
+    for ring in 0..rings {
+        for segment in 0..segments {
+            let (a, b) = (ring * row + segment, (ring + 1) * row + segment);
+            indices.push([a, b, b + 1]);
+            indices.push([a, b + 1, a + 1]);
+        }
+    }
+    (positions, indices)
 }
 
 /// The colour of a blackbody at `kelvin` (clamped to 1667–25000 K) relative to one at
@@ -1228,6 +1270,19 @@ mod tests {
                 0.5 * (b - a).cross(c - a).dot(Vec3::Z)
             })
             .sum()
+    }
+
+    #[test]
+    fn sphere_lights_are_wound_outwards() {
+        let (positions, indices) = uv_sphere(2.0);
+        // Each non-degenerate triangle's normal points away from the centre.
+        for t in &indices {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            let n = (b - a).cross(c - a);
+            if n.length() > 1e-6 {
+                assert!(n.dot(a + b + c) > 0.0, "{t:?}");
+            }
+        }
     }
 
     #[test]
