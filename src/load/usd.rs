@@ -899,10 +899,9 @@ impl UsdLoader {
         }
     }
 
-    /// A `DomeLight` of constant colour: radiance intensity × 2^exposure × color from every
-    /// direction the scene leaves open. A texture (an environment map) is not read.
-    fn add_dome(&mut self, prim: &sdf::Path) {
-        let where_ = prim.as_str();
+    /// A UsdLux light's `intensity × 2^exposure × color`, tinted by its colour temperature
+    /// when enabled.
+    fn light_strength(&self, prim: &sdf::Path) -> Vec3 {
         let intensity = self.get_f32(prim, "inputs:intensity").unwrap_or(1.0);
         let exposure = self.get_f32(prim, "inputs:exposure").unwrap_or(0.0);
         let colour = self
@@ -910,12 +909,33 @@ impl UsdLoader {
             .as_ref()
             .and_then(as_vec3)
             .unwrap_or(Vec3::ONE);
+        // Colour temperature tints relative to 6500 K, USD's default white point, which
+        // Blender writes on every light and Cycles renders white.
+        let enabled = self
+            .get(prim, "inputs:enableColorTemperature")
+            .as_ref()
+            .and_then(as_bool);
+        let colour = if enabled == Some(true) {
+            let kelvin = self
+                .get_f32(prim, "inputs:colorTemperature")
+                .unwrap_or(6500.0);
+            colour * blackbody_tint(kelvin)
+        } else {
+            colour
+        };
+        colour * intensity * exposure.exp2()
+    }
+
+    /// A `DomeLight` of constant colour: radiance intensity × 2^exposure × color from every
+    /// direction the scene leaves open. A texture (an environment map) is not read.
+    fn add_dome(&mut self, prim: &sdf::Path) {
+        let where_ = prim.as_str();
+        let radiance = self.light_strength(prim);
         if self.get(prim, "inputs:texture:file").is_some() {
             self.warn(format!(
                 "{where_}: DomeLight texture maps are not supported; using its constant colour"
             ));
         }
-        let radiance = colour * intensity * exposure.exp2();
         if radiance.is_finite() && radiance.min_element() >= 0.0 {
             self.builder.add_environment(radiance);
         } else {
@@ -974,33 +994,12 @@ impl UsdLoader {
     /// how Blender writes watts (intensity = W/π).
     fn add_light(&mut self, prim: &sdf::Path, kind: &str, world: Mat4) {
         let where_ = prim.as_str().to_string();
-        let intensity = self.get_f32(prim, "inputs:intensity").unwrap_or(1.0);
-        let exposure = self.get_f32(prim, "inputs:exposure").unwrap_or(0.0);
-        let colour = self
-            .get(prim, "inputs:color")
-            .as_ref()
-            .and_then(as_vec3)
-            .unwrap_or(Vec3::ONE);
         let normalize = self
             .get(prim, "inputs:normalize")
             .as_ref()
             .and_then(as_bool)
             .unwrap_or(false);
-        // Colour temperature tints relative to 6500 K, USD's default white point, which
-        // Blender writes on every light and Cycles renders white.
-        let enabled = self
-            .get(prim, "inputs:enableColorTemperature")
-            .as_ref()
-            .and_then(as_bool);
-        let colour = if enabled == Some(true) {
-            let kelvin = self
-                .get_f32(prim, "inputs:colorTemperature")
-                .unwrap_or(6500.0);
-            colour * blackbody_tint(kelvin)
-        } else {
-            colour
-        };
-        let strength = colour * intensity * exposure.exp2();
+        let strength = self.light_strength(prim);
         if !strength.is_finite() || strength.min_element() < 0.0 {
             self.warn(format!(
                 "{where_}: negative or non-finite light strength; skipped"
