@@ -48,3 +48,28 @@ fn ply_crashers_are_errors() {
         );
     }
 }
+
+/// Corrupt binary layers on which openusd 0.6 requests impossible allocations (which abort
+/// a process): the loader reads them in a child process first, so they come back as errors.
+#[test]
+fn usd_crashers_are_errors() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_crashes/usd");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "usdc"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "the usd crasher corpus is missing");
+    for path in files {
+        let result = gridtrace::load::usd::load(&path);
+        let message = result
+            .expect_err("a corrupt file must be an error")
+            .to_string();
+        assert!(
+            message.contains(&*path.file_name().unwrap().to_string_lossy()),
+            "{message}"
+        );
+    }
+}

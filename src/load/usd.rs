@@ -24,6 +24,10 @@ use crate::scene::{
 /// Deepest prim hierarchy walked.
 const MAX_DEPTH: usize = 256;
 
+/// Longest the forked probe of a binary layer may take before it is given up on.
+#[cfg(unix)]
+const PROBE_DEADLINE: std::time::Duration = std::time::Duration::from_secs(120);
+
 /// Segments of the polygon a `DiskLight` becomes.
 const DISK_SEGMENTS: u32 = 48;
 
@@ -45,7 +49,74 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
     )
 }
 
+/// Loads the stage once in a forked child first when the file may hold binary layers
+/// (`.usd`, `.usdc`, `.usdz`): openusd 0.6's binary reader trusts the counts it reads, and a
+/// corrupt count makes it request an impossible allocation, which aborts the process rather
+/// than failing (found by fuzzing). Values are decoded lazily, so the child does the whole
+/// load. A child that dies that way becomes an error here.
+#[cfg(unix)]
+fn probe_binary_layers(path: &Path) -> Result<(), LoadError> {
+    let text = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("usda"));
+    if text {
+        return Ok(());
+    }
+    // SAFETY: fork has no preconditions; the child below only reads the file and leaves
+    // with `_exit`, running no destructors and touching nothing it shares with the parent.
+    let pid = unsafe { libc::fork() };
+    if pid == 0 {
+        let _ = std::panic::catch_unwind(|| read_stage(path).is_ok());
+        // SAFETY: ends the child at once, as fork's documentation asks.
+        unsafe { libc::_exit(0) };
+    }
+    if pid < 0 {
+        // No child to spare: read in-process as before.
+        return Ok(());
+    }
+    // Wait, but not forever: a child stuck on a lock another thread held at the fork would
+    // otherwise hang the load. After the deadline it is killed and the file read in-process.
+    let deadline = std::time::Instant::now() + PROBE_DEADLINE;
+    let mut status = 0;
+    let waited = loop {
+        // SAFETY: polls the child forked above, with a valid status pointer.
+        let waited = unsafe { libc::waitpid(pid, &mut status, libc::WNOHANG) };
+        if waited != 0 {
+            break waited;
+        }
+        if std::time::Instant::now() > deadline {
+            // SAFETY: signals and reaps our own child.
+            unsafe {
+                libc::kill(pid, libc::SIGKILL);
+                libc::waitpid(pid, &mut status, 0);
+            }
+            return Ok(());
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    };
+    if waited == pid && libc::WIFSIGNALED(status) {
+        return Err(LoadError::Invalid {
+            path: path.to_path_buf(),
+            what: format!(
+                "the USD reader crashed on this file (signal {}); it is probably corrupt",
+                libc::WTERMSIG(status)
+            ),
+        });
+    }
+    Ok(())
+}
+
+#[cfg(not(unix))]
+fn probe_binary_layers(_path: &Path) -> Result<(), LoadError> {
+    Ok(())
+}
+
 fn load_stage(path: &Path) -> Result<Loaded, LoadError> {
+    probe_binary_layers(path)?;
+    read_stage(path)
+}
+
+fn read_stage(path: &Path) -> Result<Loaded, LoadError> {
     let invalid = |what: String| LoadError::Invalid {
         path: path.to_path_buf(),
         what,
