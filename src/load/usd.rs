@@ -726,12 +726,7 @@ impl UsdLoader {
     /// A `UsdPreviewSurface` material, mapped as glTF's are.
     fn convert_material(&mut self, material: &sdf::Path) -> Material {
         let name = material.as_str().to_string();
-        let surface = material
-            .append_property("outputs:surface")
-            .ok()
-            .and_then(|p| self.stage.attribute(p).connections().ok())
-            .and_then(|c| c.into_iter().next())
-            .map(|p| p.prim_path());
+        let surface = self.connected_prim(material, "outputs:surface");
         let Some(shader) = surface else {
             self.warn(format!(
                 "{name}: material has no surface shader; using grey diffuse"
@@ -850,12 +845,7 @@ impl UsdLoader {
         space: ColorSpace,
         material: &str,
     ) -> Option<(TextureRef, Vec3)> {
-        let source = shader
-            .append_property(input)
-            .ok()
-            .and_then(|p| self.stage.attribute(p).connections().ok())
-            .and_then(|c| c.into_iter().next())?;
-        let node = source.prim_path();
+        let node = self.connected_prim(shader, input)?;
         if self.get_token(&node, "info:id").as_deref() != Some("UsdUVTexture") {
             self.warn(format!(
                 "{material}: {input} is connected to something other than a UsdUVTexture; ignored"
@@ -893,12 +883,7 @@ impl UsdLoader {
         reference.wrap_v = wrap(self.get_token(&node, "inputs:wrapT"));
         // USD's st has v up the image, ours down: uv → st → UsdTransform2d → uv.
         let flip = Affine2::from_cols(Vec2::X, Vec2::NEG_Y, Vec2::Y);
-        let st = node
-            .append_property("inputs:st")
-            .ok()
-            .and_then(|p| self.stage.attribute(p).connections().ok())
-            .and_then(|c| c.into_iter().next())
-            .map(|p| p.prim_path());
+        let st = self.connected_prim(&node, "inputs:st");
         if let Some(st) = st
             && self.get_token(&st, "info:id").as_deref() == Some("UsdTransform2d")
         {
@@ -956,14 +941,16 @@ impl UsdLoader {
         decoded
     }
 
-    /// Textures and other networks feeding an input are not read yet: say so.
+    /// The prim whose output feeds `property` of `prim` (its first connection), if any.
+    fn connected_prim(&self, prim: &sdf::Path, property: &str) -> Option<sdf::Path> {
+        let attribute = self.stage.attribute(prim.append_property(property).ok()?);
+        let source = attribute.connections().ok()?.into_iter().next()?;
+        Some(source.prim_path())
+    }
+
+    /// Networks feeding a scalar input are not read: say so.
     fn warn_if_connected(&mut self, shader: &sdf::Path, input: &str, material: &str) {
-        let connected = shader
-            .append_property(input)
-            .ok()
-            .and_then(|p| self.stage.attribute(p).connections().ok())
-            .is_some_and(|c| !c.is_empty());
-        if connected {
+        if self.connected_prim(shader, input).is_some() {
             self.warn(format!(
                 "{material}: {input} is connected to a shader network (textures are not read from USD yet); using its constant value"
             ));

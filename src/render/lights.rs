@@ -8,7 +8,7 @@ use std::collections::HashMap;
 use glam::{Vec2, Vec3};
 
 use super::sampling::{Distribution1d, uniform_sphere, uniform_triangle};
-use super::shading::uv_at;
+use super::shading::vertex_uv;
 use super::surface::{interpolate_with_error, transform_point_with_error};
 use crate::scene::{ColorSpace, LightKind, Scene, TextureRef};
 
@@ -109,10 +109,10 @@ impl LightSet {
                     radiance: material.emission,
                     double_sided: material.double_sided,
                     texture: texture.map(|r| {
-                        let uv = [a, b, c].map(|v| {
-                            uv_at(mesh, r.texcoord, [v as usize; 3], Vec3::new(1.0, 0.0, 0.0))
-                        });
-                        (r, uv)
+                        (
+                            r,
+                            [a, b, c].map(|v| vertex_uv(mesh, r.texcoord, v as usize)),
+                        )
                     }),
                 });
             }
