@@ -1,32 +1,52 @@
-//! The command-line driver: parse arguments, load, render, write. Errors exit with code 2.
+//! The command-line driver: parse arguments, load, render, write; or merge parts rendered
+//! apart. Errors exit with code 2.
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
-use clap::Parser;
+use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::inspect::describe;
 use crate::load::{GltfLightUnits, LoadOptions, load_scene_with};
-use crate::output::{check_writable, write_image};
+use crate::merge::{merge_parts, read_part};
+use crate::output::{Format, check_writable, write_image_with_record};
+use crate::record::{RenderIdentity, RenderRecord, format_range, parse_range, sha256_file};
 use crate::render::{RenderSettings, Renderer, Strategy};
 use crate::scene::{Camera, Scene};
 
 /// Image height used when neither --width nor --height is given.
 const DEFAULT_HEIGHT: u32 = 512;
 
-/// Render a glTF 2.0 scene (.gltf, .glb) with a physically based path tracer.
+/// Render a glTF 2.0 (.gltf, .glb), USD (.usd, .usda, .usdc, .usdz) or PLY scene with a
+/// physically based path tracer.
 ///
 /// Emissive materials are area lights; metallic materials are ideal mirrors; transmissive
 /// materials are ideal glass; everything else is Lambertian. Output is linear float
 /// OpenEXR (.exr) or 8-bit sRGB PNG (.png), chosen by the output file's extension.
+///
+/// A long render can be split: `--samples A..B` renders only those samples of every pixel,
+/// and `gridtrace merge` combines the parts into the image of one render.
 #[derive(Parser, Debug)]
-#[command(name = "gridtrace", version, about, long_about)]
+#[command(
+    name = "gridtrace",
+    version,
+    about,
+    long_about,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 pub struct Args {
-    /// Scene file to render (.gltf or .glb).
-    pub scene: PathBuf,
+    /// Something other than rendering.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+
+    /// Scene file to render (.gltf, .glb, .usd, .usda, .usdc, .usdz, .ply, .ply.gz).
+    #[arg(required = true)]
+    pub scene: Option<PathBuf>,
 
     /// Output image, .exr (linear float RGBA) or .png (sRGB). [default: SCENE_STEM.exr in the current folder]
     #[arg(short, long, value_name = "FILE")]
@@ -35,6 +55,12 @@ pub struct Args {
     /// Samples per pixel: more means less noise and a longer render.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: u32,
+
+    /// Render only samples A to B−1 of every pixel, as one part of a render split across
+    /// processes or machines; `gridtrace merge` combines the parts (write them as .exr).
+    /// Any sample is the same whichever process renders it. [instead of --spp]
+    #[arg(long, value_name = "A..B", value_parser = parse_range, conflicts_with = "spp")]
+    pub samples: Option<Range<u32>>,
 
     /// Image width in pixels. [default: from --height and the camera's aspect ratio]
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
@@ -85,6 +111,35 @@ pub struct Args {
     pub gltf_light_units: GltfLightUnits,
 }
 
+/// Commands other than rendering.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Combine EXR parts of one render (rendered with --samples) into one image, equal to
+    /// the render of all their samples by one process.
+    Merge(MergeArgs),
+}
+
+/// Arguments of `gridtrace merge`.
+#[derive(clap::Args, Debug)]
+pub struct MergeArgs {
+    /// The parts: EXR files written by `gridtrace SCENE --samples A..B`, in any order.
+    #[arg(required = true, value_name = "PART")]
+    pub parts: Vec<PathBuf>,
+
+    /// The merged image, .exr (which can be merged again) or .png.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+
+    /// Fail unless the parts hold exactly these samples, so a missing part is an error
+    /// rather than a noisier image. [default: any contiguous range]
+    #[arg(long, value_name = "A..B", value_parser = parse_range)]
+    pub samples: Option<Range<u32>>,
+
+    /// No summary; errors are still printed.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
 /// Set by the first Ctrl-C: finish the current pass, write the image, exit with 130.
 static STOP: AtomicBool = AtomicBool::new(false);
 
@@ -124,23 +179,37 @@ pub fn main() -> i32 {
 /// Loads, renders and writes as `args` says; rendering stops early, and the image so far is
 /// written, once `stop` is set.
 pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
+    if let Some(Command::Merge(merge)) = &args.command {
+        return run_merge(merge).map(|()| Outcome::Completed);
+    }
+    let scene_path = args
+        .scene
+        .as_deref()
+        .ok_or_else(|| anyhow!("no scene file given"))?;
     let options = LoadOptions {
         gltf_light_units: args.gltf_light_units,
     };
     if args.inspect {
-        let loaded = load_scene_with(&args.scene, &options)?;
+        let loaded = load_scene_with(scene_path, &options)?;
         print!(
             "{}:\n{}",
-            args.scene.display(),
+            scene_path.display(),
             describe(&loaded.scene, &loaded.warnings)
         );
         return Ok(Outcome::Completed);
     }
+    let samples = args.samples.clone().unwrap_or(0..args.spp);
     let output = args
         .output
         .clone()
-        .unwrap_or_else(|| default_output(&args.scene));
+        .unwrap_or_else(|| default_output(scene_path, args.samples.as_ref()));
     check_writable(&output)?;
+    if args.samples.is_some() && Format::from_path(&output)? != Format::Exr {
+        eprintln!(
+            "warning: {}: only .exr parts can be merged; a PNG keeps no record of its samples",
+            output.display()
+        );
+    }
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = args.threads {
         pool = pool.num_threads(n as usize);
@@ -148,7 +217,9 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let pool = pool.build().context("starting worker threads")?;
 
     let load_start = Instant::now();
-    let loaded = load_scene_with(&args.scene, &options)?;
+    let scene_sha256 =
+        sha256_file(scene_path).with_context(|| format!("{}", scene_path.display()))?;
+    let loaded = load_scene_with(scene_path, &options)?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
@@ -157,19 +228,19 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     if triangles > args.max_triangles {
         bail!(
             "{}: {triangles} triangles after instancing, more than --max-triangles {}",
-            args.scene.display(),
+            scene_path.display(),
             args.max_triangles
         );
     }
     if scene.instanced_triangle_count() == 0 {
         eprintln!(
             "warning: {}: the scene has no triangles; the image will be empty",
-            args.scene.display()
+            scene_path.display()
         );
     } else if !scene.has_emitters() {
         eprintln!(
             "warning: {}: the scene has no emitters (no emissive material, no light); the image will be black",
-            args.scene.display()
+            scene_path.display()
         );
     }
 
@@ -192,7 +263,8 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let settings = RenderSettings {
         width,
         height,
-        spp: args.spp,
+        spp: samples.end - samples.start,
+        first_sample: samples.start,
         max_depth: args.max_depth,
         seed: args.seed,
         strategy: Strategy::Mis,
@@ -203,7 +275,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         eprintln!(
             "{}: {} triangles in {} instances, {} emissive, {} punctual light(s); camera {}; \
              prepared in {:.2} s",
-            args.scene.display(),
+            scene_path.display(),
             scene.instanced_triangle_count(),
             scene.instances.len(),
             renderer.lights().len(),
@@ -223,8 +295,10 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let interrupted = stats.spp < settings.spp;
     if interrupted {
         eprintln!(
-            "stopped after {} of {} samples per pixel; writing the image so far",
-            stats.spp, settings.spp
+            "stopped after {} of {} samples per pixel (samples {}); writing the image so far",
+            stats.spp,
+            settings.spp,
+            format_range(&image.samples())
         );
     }
     if stats.nonfinite > 0 {
@@ -233,11 +307,32 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
             stats.nonfinite
         );
     }
-    write_image(&output, &image)?;
+    let record = RenderRecord {
+        identity: RenderIdentity {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene_sha256,
+            camera: camera_label(&camera),
+            width,
+            height,
+            seed: settings.seed,
+            max_depth: settings.max_depth,
+            load_options: load_options_label(&options),
+        },
+        scene_name: scene_path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+        samples: image.samples(),
+        nonfinite: stats.nonfinite,
+    };
+    write_image_with_record(&output, &image, Some(&record))?;
     if !args.quiet {
         let seconds = stats.elapsed.as_secs_f64().max(1e-9);
+        let range = match args.samples {
+            Some(_) => format!(" (samples {})", format_range(&image.samples())),
+            None => String::new(),
+        };
         eprintln!(
-            "rendered {width}x{height} at {} spp in {seconds:.2} s: {:.2} M samples/s, {:.2} M rays/s; wrote {}",
+            "rendered {width}x{height} at {} spp{range} in {seconds:.2} s: {:.2} M samples/s, {:.2} M rays/s; wrote {}",
             stats.spp,
             stats.samples as f64 / seconds / 1e6,
             stats.rays as f64 / seconds / 1e6,
@@ -251,12 +346,62 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     })
 }
 
-/// `SCENE_STEM.exr` in the current folder.
-fn default_output(scene: &Path) -> PathBuf {
+/// Reads, checks and merges the parts, and writes the merged image.
+fn run_merge(args: &MergeArgs) -> Result<()> {
+    check_writable(&args.output)?;
+    let start = Instant::now();
+    let parts = args
+        .parts
+        .iter()
+        .map(|path| read_part(path))
+        .collect::<Result<Vec<_>, _>>()?;
+    let (image, record) = merge_parts(&parts, args.samples.clone())?;
+    if record.nonfinite > 0 {
+        eprintln!(
+            "warning: {} sample(s) were NaN or infinite and were dropped",
+            record.nonfinite
+        );
+    }
+    write_image_with_record(&args.output, &image, Some(&record))?;
+    if !args.quiet {
+        eprintln!(
+            "merged {} part(s) of {} ({}x{}, camera {}): samples {} in {:.2} s; wrote {}",
+            parts.len(),
+            record.scene_name,
+            image.width,
+            image.height,
+            record.identity.camera,
+            format_range(&record.samples),
+            start.elapsed().as_secs_f64(),
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+/// How the record names a camera: its name and where it came from.
+fn camera_label(camera: &Camera) -> String {
+    format!("'{}' ({})", camera.name, camera.source)
+}
+
+/// The loader options that change the scene, as the record stores them.
+fn load_options_label(options: &LoadOptions) -> String {
+    let units = options
+        .gltf_light_units
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string());
+    format!("gltf-light-units={units}")
+}
+
+/// `SCENE_STEM.exr` in the current folder; `SCENE_STEM.samples-A-B.exr` for a part.
+fn default_output(scene: &Path, samples: Option<&Range<u32>>) -> PathBuf {
     let stem = scene
         .file_stem()
         .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
-    PathBuf::from(format!("{stem}.exr"))
+    match samples {
+        Some(r) => PathBuf::from(format!("{stem}.samples-{}-{}.exr", r.start, r.end)),
+        None => PathBuf::from(format!("{stem}.exr")),
+    }
 }
 
 /// The camera asked for, the first one, or one that frames the scene.

@@ -1,7 +1,8 @@
 //! gridtrace: a physically based CPU path tracer for scenes exported from Blender.
 //!
 //! Loaders ([`load`]) turn files into a [`scene::Scene`]; the renderer ([`render`]) traces
-//! paths through per-mesh uniform grids ([`accel`]); [`output`] writes EXR or PNG.
+//! paths through per-mesh uniform grids ([`accel`]); [`output`] writes EXR or PNG, with a
+//! [`record`] of what made the image, so that parts rendered apart can be [`merge`]d.
 //!
 //! ```
 //! use glam::{Affine3A, Vec3};
@@ -31,6 +32,8 @@ pub mod accel;
 pub mod cli;
 pub mod inspect;
 pub mod load;
+pub mod merge;
 pub mod output;
+pub mod record;
 pub mod render;
 pub mod scene;

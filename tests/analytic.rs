@@ -420,6 +420,7 @@ fn objects_in_radiative_equilibrium_are_invisible() {
             max_depth: 1000,
             seed: 5,
             strategy,
+            ..RenderSettings::default()
         };
         let (image, stats) = renderer.render(&camera_at(0.9, 70.0), &settings, &|| {});
         assert_eq!(stats.nonfinite, 0);

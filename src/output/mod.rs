@@ -3,9 +3,12 @@
 mod exr;
 mod png;
 
+pub use exr::{ExrHeader, read_header as read_exr_header, read_rgba as read_exr_rgba};
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::record::{RECORD_ATTRIBUTE, RenderRecord};
 use crate::render::Image;
 
 /// An image file format gridtrace writes.
@@ -58,8 +61,18 @@ impl Format {
 /// go to a temporary file in the same folder, which is renamed over `path` only when
 /// complete, so an earlier image at `path` survives any failure.
 pub fn write_image(path: &Path, image: &Image) -> Result<(), OutputError> {
+    write_image_with_record(path, image, None)
+}
+
+/// [`write_image`], with the render's record in an EXR's header (PNG has no place for it).
+pub fn write_image_with_record(
+    path: &Path,
+    image: &Image,
+    record: Option<&RenderRecord>,
+) -> Result<(), OutputError> {
+    let record = record.map(RenderRecord::to_text);
     let bytes = match Format::from_path(path)? {
-        Format::Exr => exr::encode(image),
+        Format::Exr => exr::encode(image, record.as_deref().map(|r| (RECORD_ATTRIBUTE, r))),
         Format::Png => png::encode(image),
     }
     .map_err(|message| OutputError::Write {

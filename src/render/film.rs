@@ -1,6 +1,8 @@
 //! The image being rendered: one averaged radiance value and coverage per pixel.
 
-use glam::Vec3;
+use std::ops::Range;
+
+use glam::{DVec3, Vec3};
 
 /// A linear-radiance RGB image with coverage alpha, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
@@ -15,6 +17,9 @@ pub struct Image {
     pub alpha: Vec<f32>,
     /// Samples per pixel the image holds.
     pub spp: u32,
+    /// Index of the first of those samples: the image holds samples
+    /// `first_sample..first_sample + spp` of every pixel ([`Image::samples`]).
+    pub first_sample: u32,
 }
 
 impl Image {
@@ -27,7 +32,13 @@ impl Image {
             pixels: vec![Vec3::ZERO; n],
             alpha: vec![0.0; n],
             spp: 0,
+            first_sample: 0,
         }
+    }
+
+    /// The sample indices every pixel holds.
+    pub fn samples(&self) -> Range<u32> {
+        self.first_sample..self.first_sample + self.spp
     }
 
     /// The pixel at column `x`, row `y`.
@@ -46,10 +57,14 @@ impl Image {
 }
 
 /// Sums samples for one pixel. Non-finite samples are dropped and counted, never averaged in.
+///
+/// The sum is kept in f64 so that a pixel's mean does not depend on how its samples were
+/// grouped: the means of sample ranges rendered apart, weighted by their counts, add up to
+/// the mean of one render to within f32 rounding (see [`PixelAccumulator::from_mean`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PixelAccumulator {
-    sum: Vec3,
-    hits: u32,
+    sum: DVec3,
+    hits: u64,
     /// Samples dropped for being NaN or infinite.
     pub nonfinite: u32,
 }
@@ -58,16 +73,55 @@ impl PixelAccumulator {
     /// Adds one sample.
     pub fn add(&mut self, radiance: Vec3, hit: bool) {
         if radiance.is_finite() {
-            self.sum += radiance;
+            self.sum += radiance.as_dvec3();
         } else {
             self.nonfinite += 1;
         }
-        self.hits += u32::from(hit);
+        self.hits += u64::from(hit);
+    }
+
+    /// The accumulator of `spp` samples whose resolved mean was (`mean`, `alpha`): what a
+    /// merge starts from. The hit count is recovered exactly (alpha · spp rounds to it for
+    /// fewer than 2^23 samples); the radiance sum to within the f32 rounding of `mean`.
+    pub fn from_mean(mean: Vec3, alpha: f32, spp: u32) -> PixelAccumulator {
+        let n = f64::from(spp);
+        PixelAccumulator {
+            sum: mean.as_dvec3() * n,
+            hits: (f64::from(alpha) * n).round() as u64,
+            nonfinite: 0,
+        }
+    }
+
+    /// Adds the samples of another accumulator of the same pixel.
+    pub fn merge(&mut self, other: &PixelAccumulator) {
+        self.sum += other.sum;
+        self.hits += other.hits;
+        self.nonfinite += other.nonfinite;
     }
 
     /// The box-filtered value over `spp` samples: (radiance, alpha). A dropped sample counts
     /// as black, which biases that pixel slightly dark instead of poisoning it.
     pub fn resolve(&self, spp: u32) -> (Vec3, f32) {
-        (self.sum / spp as f32, self.hits as f32 / spp as f32)
+        let n = f64::from(spp.max(1));
+        ((self.sum / n).as_vec3(), (self.hits as f64 / n) as f32)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_range_merged_alone_is_bit_exact() {
+        let mut acc = PixelAccumulator::default();
+        for i in 0..37 {
+            acc.add(
+                Vec3::new(0.1 * i as f32, 1.0 / (i + 1) as f32, 3.7),
+                i % 3 == 0,
+            );
+        }
+        let (mean, alpha) = acc.resolve(37);
+        let again = PixelAccumulator::from_mean(mean, alpha, 37).resolve(37);
+        assert_eq!(again, (mean, alpha));
     }
 }

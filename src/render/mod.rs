@@ -38,6 +38,10 @@ pub struct RenderSettings {
     pub height: u32,
     /// Samples per pixel.
     pub spp: u32,
+    /// Index of the first sample: the render takes samples `first_sample..first_sample + spp`
+    /// of every pixel, so a long render can be split into ranges taken by different
+    /// processes and merged (see [`crate::merge`]).
+    pub first_sample: u32,
     /// Most scattering events along a path (0: emitters seen directly only).
     pub max_depth: u32,
     /// Seed of every random stream: the same seed gives the same image.
@@ -52,6 +56,7 @@ impl Default for RenderSettings {
             width: 512,
             height: 512,
             spp: 64,
+            first_sample: 0,
             max_depth: 16,
             seed: 0,
             strategy: Strategy::Mis,
@@ -120,9 +125,10 @@ impl<'a> Renderer<'a> {
     /// `stop` becomes true; the image then holds the samples of the finished passes
     /// ([`Image::spp`]).
     ///
-    /// Each pixel draws from its own random stream, seeded by the pixel index and the seed,
-    /// which carries over from pass to pass, and sums its samples in a fixed order, so the
-    /// image is bit-identical for any number of threads and does not depend on the passes.
+    /// Every sample draws from its own random stream, keyed by the seed, the pixel index and
+    /// the sample index ([`Rng::for_sample`]), and each pixel sums its samples in a fixed
+    /// order, so the image is bit-identical for any number of threads, and a sample is the
+    /// same whichever process renders it.
     pub fn render_until(
         &self,
         camera: &Camera,
@@ -133,22 +139,24 @@ impl<'a> Renderer<'a> {
         let start = Instant::now();
         let generator = RayGenerator::new(camera, settings.width, settings.height);
         let width = settings.width as usize;
-        let spp = settings.spp.max(1);
+        let spp = settings.spp.max(1).min(u32::MAX - settings.first_sample);
         let seed = mix64(settings.seed);
-        let mut pixels: Vec<(Rng, PixelAccumulator)> = (0..width * settings.height as usize)
-            .map(|i| (Rng::new(seed, i as u64), PixelAccumulator::default()))
-            .collect();
+        let mut pixels = vec![PixelAccumulator::default(); width * settings.height as usize];
         let mut stats = RenderStats::default();
         while stats.spp < spp {
+            let sample = settings.first_sample + stats.spp;
             stats.rays += pixels
                 .par_chunks_mut(width)
                 .enumerate()
                 .map(|(y, row)| {
                     let mut rays = 0u64;
-                    for (x, (rng, acc)) in row.iter_mut().enumerate() {
+                    for (x, acc) in row.iter_mut().enumerate() {
+                        let pixel = (y * width + x) as u64;
+                        let mut rng = Rng::for_sample(seed, pixel, sample);
                         let jitter = rng.uniform2();
                         let ray = generator.generate(x as f32 + jitter.x, y as f32 + jitter.y);
-                        let path = self.trace_path(ray, rng, settings.max_depth, settings.strategy);
+                        let path =
+                            self.trace_path(ray, &mut rng, settings.max_depth, settings.strategy);
                         rays += path.rays;
                         acc.add(path.radiance, path.hit);
                     }
@@ -163,7 +171,8 @@ impl<'a> Renderer<'a> {
         }
         let mut image = Image::new(settings.width, settings.height);
         image.spp = stats.spp;
-        for (i, (_, acc)) in pixels.iter().enumerate() {
+        image.first_sample = settings.first_sample;
+        for (i, acc) in pixels.iter().enumerate() {
             (image.pixels[i], image.alpha[i]) = acc.resolve(stats.spp);
             stats.nonfinite += acc.nonfinite as u64;
         }

@@ -26,6 +26,13 @@ impl Rng {
         rng
     }
 
+    /// The generator of one camera sample: its numbers depend on (seed, pixel, sample index)
+    /// alone, so a sample is the same whichever process, thread or pass takes it, and sample
+    /// ranges rendered apart merge into exactly the image of one render.
+    pub fn for_sample(seed: u64, pixel: u64, sample: u32) -> Rng {
+        Rng::new(seed ^ mix64(u64::from(sample)), pixel)
+    }
+
     /// The next 32 random bits.
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;

@@ -1,0 +1,282 @@
+//! Merging parts of one render: EXR images of the same scene and settings that hold disjoint
+//! sample ranges (`gridtrace SCENE --samples A..B`) combine into the image one process
+//! rendering all their samples would have made.
+//!
+//! Every sample's random numbers depend on (seed, pixel, sample index) alone, so a part
+//! holds exactly the samples a single render would have taken; each part stores per pixel
+//! the f32 mean of its samples, and the merge weights the means by their sample counts in
+//! f64. Radiance is never negative, so the only difference from one render is the f32
+//! rounding of each part's mean and of the result: a merged pixel is within a relative
+//! [`MERGE_TOLERANCE`] of the single render's (4 units of 2^-24, about two units in the last
+//! place), and bit-identical for one part. Alpha (hit counts) merges exactly.
+
+use std::fmt;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use crate::output::{read_exr_header, read_exr_rgba};
+use crate::record::{RECORD_ATTRIBUTE, RecordError, RenderRecord, format_range};
+use crate::render::{Image, PixelAccumulator};
+
+/// Largest relative difference between a merged pixel and the single render's: 2^-22.
+pub const MERGE_TOLERANCE: f32 = 1.0 / (1u32 << 22) as f32;
+
+/// Parts bigger than this are refused before their pixels are read (a damaged header could
+/// otherwise ask for any amount of memory).
+const MAX_PART_PIXELS: usize = 1 << 28;
+
+/// One rendered part: its file, its record and its pixels.
+#[derive(Clone, Debug)]
+pub struct Part {
+    /// Where it was read from, for messages.
+    pub path: PathBuf,
+    /// What rendered it and which samples it holds.
+    pub record: RenderRecord,
+    /// Mean radiance and alpha of its samples.
+    pub image: Image,
+}
+
+/// Why parts cannot be merged. Every message names the files concerned.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    /// Nothing to merge.
+    #[error("no parts to merge")]
+    NoParts,
+    /// The file is not a readable EXR.
+    #[error("{}: cannot read it as OpenEXR: {message}", path.display())]
+    Unreadable {
+        /// The part.
+        path: PathBuf,
+        /// What the EXR reader said.
+        message: String,
+    },
+    /// The EXR has no render record.
+    #[error("{}: not a gridtrace render: {source}", path.display())]
+    NotAPart {
+        /// The part.
+        path: PathBuf,
+        /// What is missing from its header.
+        source: RecordError,
+    },
+    /// The pixels do not match the record, or hold values no render makes.
+    #[error("{}: {message}; the file is damaged or was edited", path.display())]
+    Damaged {
+        /// The part.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// Two parts come from different renders.
+    #[error(
+        "{} and {} are not parts of one render: their {field} differs ('{ours}' and '{theirs}')",
+        first.display(), other.display()
+    )]
+    Mismatch {
+        /// The first part.
+        first: PathBuf,
+        /// The part that differs from it.
+        other: PathBuf,
+        /// The record field that differs.
+        field: &'static str,
+        /// The first part's value.
+        ours: String,
+        /// The other part's value.
+        theirs: String,
+    },
+    /// Two parts share samples.
+    #[error(
+        "{} (samples {}) and {} (samples {}) overlap: samples {} would be counted twice",
+        first.display(), Samples(first_samples), second.display(), Samples(second_samples),
+        Samples(overlap)
+    )]
+    Overlap {
+        /// One part.
+        first: PathBuf,
+        /// Its samples.
+        first_samples: Range<u32>,
+        /// The other part.
+        second: PathBuf,
+        /// Its samples.
+        second_samples: Range<u32>,
+        /// The samples both hold.
+        overlap: Range<u32>,
+    },
+    /// The parts leave samples out between them.
+    #[error(
+        "no part holds samples {} (between {} and {}): render them with --samples {}",
+        Samples(missing), before.display(), after.display(), Samples(missing)
+    )]
+    Gap {
+        /// The samples no part holds.
+        missing: Range<u32>,
+        /// The part that ends before them.
+        before: PathBuf,
+        /// The part that starts after them.
+        after: PathBuf,
+    },
+    /// The parts do not cover the range asked for.
+    #[error(
+        "the parts hold samples {}, but {} were asked for",
+        Samples(have),
+        Samples(wanted)
+    )]
+    Incomplete {
+        /// What the parts hold together.
+        have: Range<u32>,
+        /// What was asked for.
+        wanted: Range<u32>,
+    },
+}
+
+/// A sample range as `A..B` in messages.
+struct Samples<'a>(&'a Range<u32>);
+
+impl fmt::Display for Samples<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&format_range(self.0))
+    }
+}
+
+/// Reads one part, checking that its pixels agree with its record.
+pub fn read_part(path: &Path) -> Result<Part, MergeError> {
+    let unreadable = |message: String| MergeError::Unreadable {
+        path: path.to_path_buf(),
+        message,
+    };
+    let damaged = |message: String| MergeError::Damaged {
+        path: path.to_path_buf(),
+        message,
+    };
+    let header = read_exr_header(path).map_err(unreadable)?;
+    let record = header
+        .text
+        .get(RECORD_ATTRIBUTE)
+        .ok_or(RecordError::NoRecord)
+        .and_then(|text| RenderRecord::from_text(text))
+        .map_err(|source| MergeError::NotAPart {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    let (width, height) = (record.identity.width, record.identity.height);
+    if (header.width, header.height) != (width as usize, height as usize) {
+        return Err(damaged(format!(
+            "the record says {width}x{height} pixels but the image is {}x{}",
+            header.width, header.height
+        )));
+    }
+    if header.width.saturating_mul(header.height) > MAX_PART_PIXELS {
+        return Err(damaged(format!(
+            "{width}x{height} is more pixels than gridtrace renders by default"
+        )));
+    }
+    let (pixels, alpha) = read_exr_rgba(path).map_err(unreadable)?;
+    let bad_pixel = pixels
+        .iter()
+        .zip(&alpha)
+        .position(|(p, a)| !is_rendered_value(*p, *a));
+    if let Some(i) = bad_pixel {
+        return Err(damaged(format!(
+            "pixel ({}, {}) holds {:?} alpha {}, which no render makes",
+            i % width as usize,
+            i / width as usize,
+            pixels[i],
+            alpha[i]
+        )));
+    }
+    let samples = record.samples.clone();
+    Ok(Part {
+        path: path.to_path_buf(),
+        image: Image {
+            width,
+            height,
+            pixels,
+            alpha,
+            spp: samples.end - samples.start,
+            first_sample: samples.start,
+        },
+        record,
+    })
+}
+
+/// Radiance is finite and never negative; alpha is a fraction.
+fn is_rendered_value(radiance: Vec3, alpha: f32) -> bool {
+    radiance.is_finite() && radiance.min_element() >= 0.0 && (0.0..=1.0).contains(&alpha)
+}
+
+/// Checks that `parts` belong to one render and hold disjoint, contiguous sample ranges
+/// (covering `wanted` if given), and combines them: the merged image and its record.
+/// The result does not depend on the order of `parts`.
+pub fn merge_parts(
+    parts: &[Part],
+    wanted: Option<Range<u32>>,
+) -> Result<(Image, RenderRecord), MergeError> {
+    let first = parts.first().ok_or(MergeError::NoParts)?;
+    for part in &parts[1..] {
+        if let Some((field, ours, theirs)) = first.record.identity.difference(&part.record.identity)
+        {
+            return Err(MergeError::Mismatch {
+                first: first.path.clone(),
+                other: part.path.clone(),
+                field,
+                ours,
+                theirs,
+            });
+        }
+    }
+    let mut order: Vec<&Part> = parts.iter().collect();
+    order.sort_by_key(|p| (p.record.samples.start, p.record.samples.end));
+    for pair in order.windows(2) {
+        let (a, b) = (&pair[0].record.samples, &pair[1].record.samples);
+        if b.start < a.end {
+            return Err(MergeError::Overlap {
+                first: pair[0].path.clone(),
+                first_samples: a.clone(),
+                second: pair[1].path.clone(),
+                second_samples: b.clone(),
+                overlap: b.start..a.end.min(b.end),
+            });
+        }
+        if b.start > a.end {
+            return Err(MergeError::Gap {
+                missing: a.end..b.start,
+                before: pair[0].path.clone(),
+                after: pair[1].path.clone(),
+            });
+        }
+    }
+    let have = order[0].record.samples.start..order[order.len() - 1].record.samples.end;
+    if let Some(wanted) = wanted
+        && wanted != have
+    {
+        return Err(MergeError::Incomplete { have, wanted });
+    }
+
+    let identity = &first.record.identity;
+    let mut pixels = vec![PixelAccumulator::default(); first.image.pixels.len()];
+    for part in &order {
+        for (i, acc) in pixels.iter_mut().enumerate() {
+            let from = PixelAccumulator::from_mean(
+                part.image.pixels[i],
+                part.image.alpha[i],
+                part.image.spp,
+            );
+            acc.merge(&from);
+        }
+    }
+    let spp = have.end - have.start;
+    let mut image = Image::new(identity.width, identity.height);
+    image.spp = spp;
+    image.first_sample = have.start;
+    for (i, acc) in pixels.iter().enumerate() {
+        (image.pixels[i], image.alpha[i]) = acc.resolve(spp);
+    }
+    let record = RenderRecord {
+        identity: identity.clone(),
+        scene_name: first.record.scene_name.clone(),
+        samples: have,
+        nonfinite: parts.iter().map(|p| p.record.nonfinite).sum(),
+    };
+    Ok((image, record))
+}

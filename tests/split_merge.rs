@@ -1,0 +1,276 @@
+//! A render split into sample ranges and merged equals one render of all the samples, to
+//! the stated f32 rounding bound; sets of parts that do not make one render are refused
+//! with messages that name the files.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use gridtrace::load::load_scene;
+use gridtrace::merge::{MERGE_TOLERANCE, MergeError, merge_parts, read_part};
+use gridtrace::output::{write_image, write_image_with_record};
+use gridtrace::record::{RenderIdentity, RenderRecord};
+use gridtrace::render::{Image, RenderSettings, Renderer};
+use gridtrace::scene::Camera;
+
+const SIZE: u32 = 32;
+const SPP: u32 = 16;
+
+fn cornell_box() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell_box.glb")
+}
+
+fn record(samples: Range<u32>, seed: u64) -> RenderRecord {
+    RenderRecord {
+        identity: RenderIdentity {
+            version: "test".into(),
+            scene_sha256: "0".repeat(64),
+            camera: "'Camera'".into(),
+            width: SIZE,
+            height: SIZE,
+            seed,
+            max_depth: 8,
+            load_options: String::new(),
+        },
+        scene_name: "cornell_box.glb".into(),
+        samples,
+        nonfinite: 0,
+    }
+}
+
+/// Renders samples `range` of the Cornell box.
+fn render(renderer: &Renderer, camera: &Camera, range: Range<u32>, seed: u64) -> Image {
+    let settings = RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        spp: range.end - range.start,
+        first_sample: range.start,
+        max_depth: 8,
+        seed,
+        ..RenderSettings::default()
+    };
+    renderer.render(camera, &settings, &|| {}).0
+}
+
+/// The largest difference between two images relative to the larger value, and whether
+/// every alpha is identical.
+fn relative_difference(a: &Image, b: &Image) -> f32 {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c], q[c])))
+        .map(|(x, y)| {
+            let scale = x.abs().max(y.abs());
+            if scale == 0.0 {
+                0.0
+            } else {
+                (x - y).abs() / scale
+            }
+        })
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn merged_parts_equal_one_render_for_one_two_and_four_parts() {
+    let scene = load_scene(&cornell_box()).unwrap().scene;
+    let camera = scene.cameras[0].clone();
+    let renderer = Renderer::new(&scene);
+    let whole = render(&renderer, &camera, 0..SPP, 3);
+    let dir = tempfile::tempdir().unwrap();
+    let splits: [&[u32]; 3] = [&[0, SPP], &[0, 7, SPP], &[0, 3, 8, 13, SPP]];
+    for bounds in splits {
+        let mut paths = Vec::new();
+        // Written in reverse: the merge does not depend on the order it is given the parts.
+        for pair in bounds.windows(2).rev() {
+            let range = pair[0]..pair[1];
+            let part = render(&renderer, &camera, range.clone(), 3);
+            let path = dir
+                .path()
+                .join(format!("part-{}-{}.exr", range.start, range.end));
+            write_image_with_record(&path, &part, Some(&record(range, 3))).unwrap();
+            paths.push(path);
+        }
+        let parts: Vec<_> = paths.iter().map(|p| read_part(p).unwrap()).collect();
+        let (merged, merged_record) = merge_parts(&parts, Some(0..SPP)).unwrap();
+        assert_eq!(merged_record.samples, 0..SPP);
+        assert_eq!((merged.spp, merged.first_sample), (SPP, 0));
+        assert_eq!(merged.alpha, whole.alpha, "alpha merges exactly");
+        let difference = relative_difference(&merged, &whole);
+        println!(
+            "{} part(s): largest relative difference {difference:e} (bound {MERGE_TOLERANCE:e})",
+            parts.len()
+        );
+        if parts.len() == 1 {
+            assert_eq!(merged.pixels, whole.pixels, "one part is bit-identical");
+        }
+        assert!(
+            difference <= MERGE_TOLERANCE,
+            "{} parts: {difference:e} > {MERGE_TOLERANCE:e}",
+            parts.len()
+        );
+    }
+    // The comparison has teeth: another seed's render is nowhere near the bound.
+    let other = render(&renderer, &camera, 0..SPP, 4);
+    assert!(relative_difference(&other, &whole) > 1000.0 * MERGE_TOLERANCE);
+}
+
+/// Writes a part with `record` and returns its path.
+fn part(dir: &Path, name: &str, record: RenderRecord) -> PathBuf {
+    let mut image = Image::new(SIZE, SIZE);
+    image.spp = record.samples.end - record.samples.start;
+    image.first_sample = record.samples.start;
+    let path = dir.join(name);
+    write_image_with_record(&path, &image, Some(&record)).unwrap();
+    path
+}
+
+fn merge_files(paths: &[&PathBuf], wanted: Option<Range<u32>>) -> Result<Image, MergeError> {
+    let parts = paths
+        .iter()
+        .map(|p| read_part(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    merge_parts(&parts, wanted).map(|(image, _)| image)
+}
+
+fn assert_error(result: Result<Image, MergeError>, needles: &[&str]) {
+    let message = result.expect_err("the merge must fail").to_string();
+    for needle in needles {
+        assert!(message.contains(needle), "'{needle}' not in: {message}");
+    }
+}
+
+#[test]
+fn bad_part_sets_are_refused_naming_the_parts() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = part(d, "a.exr", record(0..8, 1));
+    let b = part(d, "b.exr", record(8..16, 1));
+    let c = part(d, "c.exr", record(16..24, 1));
+    let overlapping = part(d, "overlapping.exr", record(4..12, 1));
+    let other_seed = part(d, "seed2.exr", record(8..16, 2));
+    let mut other_scene = record(8..16, 1);
+    other_scene.identity.scene_sha256 = "1".repeat(64);
+    let other_scene = part(d, "other_scene.exr", other_scene);
+
+    assert!(merge_files(&[&c, &a, &b], Some(0..24)).is_ok());
+    assert_error(
+        merge_files(&[&a, &c], None),
+        &["a.exr", "c.exr", "samples 8..16", "--samples 8..16"],
+    );
+    assert_error(
+        merge_files(&[&a, &overlapping, &b], None),
+        &["a.exr", "overlapping.exr", "samples 4..8"],
+    );
+    assert_error(merge_files(&[&a, &a], None), &["a.exr", "overlap"]);
+    assert_error(
+        merge_files(&[&a, &other_seed], None),
+        &["a.exr", "seed2.exr", "seed", "'1' and '2'"],
+    );
+    assert_error(
+        merge_files(&[&a, &other_scene], None),
+        &["other_scene.exr", "sceneSha256"],
+    );
+    assert_error(merge_files(&[&a, &b], Some(0..24)), &["0..16", "0..24"]);
+    assert_error(merge_files(&[], None), &["no parts"]);
+
+    // Files that are not parts.
+    let plain = d.join("plain.exr");
+    write_image(&plain, &Image::new(SIZE, SIZE)).unwrap();
+    assert_error(
+        merge_files(&[&plain], None),
+        &["plain.exr", "gridtrace/record", "not a gridtrace render"],
+    );
+    let text = d.join("text.exr");
+    std::fs::write(&text, "not an image").unwrap();
+    assert_error(merge_files(&[&text], None), &["text.exr", "OpenEXR"]);
+    let missing = d.join("missing.exr");
+    assert_error(merge_files(&[&missing], None), &["missing.exr"]);
+    let mut nan = Image::new(SIZE, SIZE);
+    nan.pixels[5].y = f32::NAN;
+    nan.spp = 8;
+    let damaged = d.join("damaged.exr");
+    write_image_with_record(&damaged, &nan, Some(&record(0..8, 1))).unwrap();
+    assert_error(
+        merge_files(&[&damaged], None),
+        &["damaged.exr", "pixel (5, 0)"],
+    );
+    let mut small = record(0..8, 1);
+    small.identity.width = SIZE / 2;
+    let wrong_size = part(d, "wrong_size.exr", small);
+    assert_error(
+        merge_files(&[&wrong_size], None),
+        &["wrong_size.exr", "16x32", "32x32"],
+    );
+}
+
+fn gridtrace(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gridtrace"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("run gridtrace")
+}
+
+fn read(path: &Path) -> Image {
+    read_part(path).unwrap_or_else(|e| panic!("{e}")).image
+}
+
+#[test]
+fn the_command_line_splits_and_merges() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = cornell_box().display().to_string();
+    let common = ["--width", "24", "-q"];
+    let run = |extra: &[&str]| {
+        let args: Vec<&str> = [scene.as_str()]
+            .into_iter()
+            .chain(common)
+            .chain(extra.iter().copied())
+            .collect();
+        let out = gridtrace(&args, d);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    run(&["--seed", "9", "--spp", "12", "-o", "whole.exr"]);
+    run(&["--seed", "9", "--samples", "0..5"]);
+    run(&["--seed", "9", "--samples", "5..12", "--threads", "1"]);
+    let out = gridtrace(
+        &[
+            "merge",
+            "cornell_box.samples-5-12.exr",
+            "cornell_box.samples-0-5.exr",
+            "--samples",
+            "0..12",
+            "-o",
+            "merged.exr",
+        ],
+        d,
+    );
+    let summary = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{summary}");
+    assert!(
+        summary.contains("merged 2 part(s)") && summary.contains("0..12"),
+        "{summary}"
+    );
+    let (whole, merged) = (read(&d.join("whole.exr")), read(&d.join("merged.exr")));
+    assert_eq!(merged.alpha, whole.alpha);
+    assert!(relative_difference(&merged, &whole) <= MERGE_TOLERANCE);
+
+    // The record holds what the merge checks: another seed is refused.
+    run(&["--samples", "12..16", "--seed", "10", "-o", "seed10.exr"]);
+    let out = gridtrace(&["merge", "merged.exr", "seed10.exr", "-o", "bad.exr"], d);
+    assert_eq!(out.status.code(), Some(2));
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        message.contains("seed10.exr") && message.contains("seed"),
+        "{message}"
+    );
+    assert!(!d.join("bad.exr").exists());
+
+    // --spp and --samples are two ways of saying how many samples: not both.
+    let out = gridtrace(&[&scene, "--spp", "4", "--samples", "0..4"], d);
+    assert_eq!(out.status.code(), Some(2));
+}
