@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::inspect::describe;
 use crate::load::{GltfLightUnits, LoadOptions, load_scene_with};
-use crate::merge::{merge_parts, read_part};
+use crate::merge::merge_files;
 use crate::output::{Format, check_writable, write_image_with_record};
 use crate::record::{RenderIdentity, RenderRecord, format_range, parse_range, sha256_file};
 use crate::render::{RenderSettings, Renderer, Strategy};
@@ -350,12 +350,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
 fn run_merge(args: &MergeArgs) -> Result<()> {
     check_writable(&args.output)?;
     let start = Instant::now();
-    let parts = args
-        .parts
-        .iter()
-        .map(|path| read_part(path))
-        .collect::<Result<Vec<_>, _>>()?;
-    let (image, record) = merge_parts(&parts, args.samples.clone())?;
+    let (image, record) = merge_files(&args.parts, args.samples.clone())?;
     if record.nonfinite > 0 {
         eprintln!(
             "warning: {} sample(s) were NaN or infinite and were dropped",
@@ -366,7 +361,7 @@ fn run_merge(args: &MergeArgs) -> Result<()> {
     if !args.quiet {
         eprintln!(
             "merged {} part(s) of {} ({}x{}, camera {}): samples {} in {:.2} s; wrote {}",
-            parts.len(),
+            args.parts.len(),
             record.scene_name,
             image.width,
             image.height,

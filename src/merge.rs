@@ -27,15 +27,14 @@ pub const MERGE_TOLERANCE: f32 = 1.0 / (1u32 << 22) as f32;
 /// otherwise ask for any amount of memory).
 const MAX_PART_PIXELS: usize = 1 << 28;
 
-/// One rendered part: its file, its record and its pixels.
+/// One rendered part as its header describes it; the pixels are read when needed
+/// ([`Part::read_image`]), so a merge holds one part's pixels at a time.
 #[derive(Clone, Debug)]
 pub struct Part {
     /// Where it was read from, for messages.
     pub path: PathBuf,
     /// What rendered it and which samples it holds.
     pub record: RenderRecord,
-    /// Mean radiance and alpha of its samples.
-    pub image: Image,
 }
 
 /// Why parts cannot be merged. Every message names the files concerned.
@@ -139,17 +138,16 @@ impl fmt::Display for Samples<'_> {
     }
 }
 
-/// Reads one part, checking that its pixels agree with its record.
+/// Reads one part's header: its record, checked against the image size.
 pub fn read_part(path: &Path) -> Result<Part, MergeError> {
-    let unreadable = |message: String| MergeError::Unreadable {
+    let part = |record| Part {
+        path: path.to_path_buf(),
+        record,
+    };
+    let header = read_exr_header(path).map_err(|message| MergeError::Unreadable {
         path: path.to_path_buf(),
         message,
-    };
-    let damaged = |message: String| MergeError::Damaged {
-        path: path.to_path_buf(),
-        message,
-    };
-    let header = read_exr_header(path).map_err(unreadable)?;
+    })?;
     let record = header
         .text
         .get(RECORD_ATTRIBUTE)
@@ -161,43 +159,65 @@ pub fn read_part(path: &Path) -> Result<Part, MergeError> {
         })?;
     let (width, height) = (record.identity.width, record.identity.height);
     if (header.width, header.height) != (width as usize, height as usize) {
-        return Err(damaged(format!(
+        return Err(part(record).damaged(format!(
             "the record says {width}x{height} pixels but the image is {}x{}",
             header.width, header.height
         )));
     }
     if header.width.saturating_mul(header.height) > MAX_PART_PIXELS {
-        return Err(damaged(format!(
+        return Err(part(record).damaged(format!(
             "{width}x{height} is more pixels than gridtrace renders by default"
         )));
     }
-    let (pixels, alpha) = read_exr_rgba(path).map_err(unreadable)?;
-    let bad_pixel = pixels
-        .iter()
-        .zip(&alpha)
-        .position(|(p, a)| !is_rendered_value(*p, *a));
-    if let Some(i) = bad_pixel {
-        return Err(damaged(format!(
-            "pixel ({}, {}) holds {:?} alpha {}, which no render makes",
-            i % width as usize,
-            i / width as usize,
-            pixels[i],
-            alpha[i]
-        )));
-    }
-    let samples = record.samples.clone();
-    Ok(Part {
-        path: path.to_path_buf(),
-        image: Image {
+    Ok(part(record))
+}
+
+impl Part {
+    /// Reads the pixels: the mean radiance and alpha of the part's samples, checked to be
+    /// values a render makes.
+    pub fn read_image(&self) -> Result<Image, MergeError> {
+        let (pixels, alpha) =
+            read_exr_rgba(&self.path).map_err(|message| MergeError::Unreadable {
+                path: self.path.clone(),
+                message,
+            })?;
+        let (width, height) = (self.record.identity.width, self.record.identity.height);
+        if pixels.len() != width as usize * height as usize {
+            return Err(self.damaged(format!(
+                "{} pixels where the header says {width}x{height}",
+                pixels.len()
+            )));
+        }
+        let bad_pixel = pixels
+            .iter()
+            .zip(&alpha)
+            .position(|(p, a)| !is_rendered_value(*p, *a));
+        if let Some(i) = bad_pixel {
+            return Err(self.damaged(format!(
+                "pixel ({}, {}) holds {:?} alpha {}, which no render makes",
+                i % width as usize,
+                i / width as usize,
+                pixels[i],
+                alpha[i]
+            )));
+        }
+        let samples = &self.record.samples;
+        Ok(Image {
             width,
             height,
             pixels,
             alpha,
             spp: samples.end - samples.start,
             first_sample: samples.start,
-        },
-        record,
-    })
+        })
+    }
+
+    fn damaged(&self, message: String) -> MergeError {
+        MergeError::Damaged {
+            path: self.path.clone(),
+            message,
+        }
+    }
 }
 
 /// Radiance is finite and never negative; alpha is a fraction.
@@ -205,9 +225,22 @@ fn is_rendered_value(radiance: Vec3, alpha: f32) -> bool {
     radiance.is_finite() && radiance.min_element() >= 0.0 && (0.0..=1.0).contains(&alpha)
 }
 
-/// Checks that `parts` belong to one render and hold disjoint, contiguous sample ranges
-/// (covering `wanted` if given), and combines them: the merged image and its record.
-/// The result does not depend on the order of `parts`.
+/// Reads the parts at `paths`, checks that they belong to one render and hold disjoint,
+/// contiguous sample ranges (covering `wanted` if given), and combines them: the merged
+/// image and its record. Every header is checked before any pixels are read; the result
+/// does not depend on the order of `paths`.
+pub fn merge_files(
+    paths: &[PathBuf],
+    wanted: Option<Range<u32>>,
+) -> Result<(Image, RenderRecord), MergeError> {
+    let parts = paths
+        .iter()
+        .map(|p| read_part(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    merge_parts(&parts, wanted)
+}
+
+/// [`merge_files`] for parts whose headers are read.
 pub fn merge_parts(
     parts: &[Part],
     wanted: Option<Range<u32>>,
@@ -254,14 +287,12 @@ pub fn merge_parts(
     }
 
     let identity = &first.record.identity;
-    let mut pixels = vec![PixelAccumulator::default(); first.image.pixels.len()];
+    let mut pixels =
+        vec![PixelAccumulator::default(); identity.width as usize * identity.height as usize];
     for part in &order {
+        let image = part.read_image()?;
         for (i, acc) in pixels.iter_mut().enumerate() {
-            let from = PixelAccumulator::from_mean(
-                part.image.pixels[i],
-                part.image.alpha[i],
-                part.image.spp,
-            );
+            let from = PixelAccumulator::from_mean(image.pixels[i], image.alpha[i], image.spp);
             acc.merge(&from);
         }
     }

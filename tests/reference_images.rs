@@ -13,14 +13,22 @@ fn cornell_box_matches_cycles() {
     check_scene("cornell_box", 512);
 }
 
+/// Samples per pixel for scenes lit through glass (caustics). Their block means are
+/// heavy-tailed: a block's rare bright paths (diffuse → glass → light) are often missed
+/// entirely, so it reads low while its measured noise stays small. At 512 spp the max-|z|
+/// limit of 5 failed for 4 of 6 seed sets of `cornell_spheres` (up to 12.6, always
+/// gridtrace low, in a different block each time) and for 1 of 2 of `caustic`, though the
+/// image means agreed to 0.1 %; at 2048 spp 6 of 6 seed sets passed (max |z| 3.2–4.9).
+const CAUSTIC_SPP: u32 = 2048;
+
 #[test]
 fn cornell_spheres_match_cycles() {
-    check_scene("cornell_spheres", 512);
+    check_scene("cornell_spheres", CAUSTIC_SPP);
 }
 
 #[test]
 fn caustic_under_a_glass_sphere_matches_cycles() {
-    check_scene("caustic", 512);
+    check_scene("caustic", CAUSTIC_SPP);
 }
 
 #[test]

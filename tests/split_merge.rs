@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use gridtrace::load::load_scene;
-use gridtrace::merge::{MERGE_TOLERANCE, MergeError, merge_parts, read_part};
+use gridtrace::merge::{MERGE_TOLERANCE, MergeError, merge_files, read_part};
 use gridtrace::output::{write_image, write_image_with_record};
 use gridtrace::record::{RenderIdentity, RenderRecord};
 use gridtrace::render::{Image, RenderSettings, Renderer};
@@ -90,23 +90,22 @@ fn merged_parts_equal_one_render_for_one_two_and_four_parts() {
             write_image_with_record(&path, &part, Some(&record(range, 3))).unwrap();
             paths.push(path);
         }
-        let parts: Vec<_> = paths.iter().map(|p| read_part(p).unwrap()).collect();
-        let (merged, merged_record) = merge_parts(&parts, Some(0..SPP)).unwrap();
+        let (merged, merged_record) = merge_files(&paths, Some(0..SPP)).unwrap();
         assert_eq!(merged_record.samples, 0..SPP);
         assert_eq!((merged.spp, merged.first_sample), (SPP, 0));
         assert_eq!(merged.alpha, whole.alpha, "alpha merges exactly");
         let difference = relative_difference(&merged, &whole);
         println!(
             "{} part(s): largest relative difference {difference:e} (bound {MERGE_TOLERANCE:e})",
-            parts.len()
+            paths.len()
         );
-        if parts.len() == 1 {
+        if paths.len() == 1 {
             assert_eq!(merged.pixels, whole.pixels, "one part is bit-identical");
         }
         assert!(
             difference <= MERGE_TOLERANCE,
             "{} parts: {difference:e} > {MERGE_TOLERANCE:e}",
-            parts.len()
+            paths.len()
         );
     }
     // The comparison has teeth: another seed's render is nowhere near the bound.
@@ -124,12 +123,9 @@ fn part(dir: &Path, name: &str, record: RenderRecord) -> PathBuf {
     path
 }
 
-fn merge_files(paths: &[&PathBuf], wanted: Option<Range<u32>>) -> Result<Image, MergeError> {
-    let parts = paths
-        .iter()
-        .map(|p| read_part(p))
-        .collect::<Result<Vec<_>, _>>()?;
-    merge_parts(&parts, wanted).map(|(image, _)| image)
+fn merge(paths: &[&PathBuf], wanted: Option<Range<u32>>) -> Result<Image, MergeError> {
+    let paths: Vec<PathBuf> = paths.iter().map(|p| p.to_path_buf()).collect();
+    merge_files(&paths, wanted).map(|(image, _)| image)
 }
 
 fn assert_error(result: Result<Image, MergeError>, needles: &[&str]) {
@@ -152,53 +148,50 @@ fn bad_part_sets_are_refused_naming_the_parts() {
     other_scene.identity.scene_sha256 = "1".repeat(64);
     let other_scene = part(d, "other_scene.exr", other_scene);
 
-    assert!(merge_files(&[&c, &a, &b], Some(0..24)).is_ok());
+    assert!(merge(&[&c, &a, &b], Some(0..24)).is_ok());
     assert_error(
-        merge_files(&[&a, &c], None),
+        merge(&[&a, &c], None),
         &["a.exr", "c.exr", "samples 8..16", "--samples 8..16"],
     );
     assert_error(
-        merge_files(&[&a, &overlapping, &b], None),
+        merge(&[&a, &overlapping, &b], None),
         &["a.exr", "overlapping.exr", "samples 4..8"],
     );
-    assert_error(merge_files(&[&a, &a], None), &["a.exr", "overlap"]);
+    assert_error(merge(&[&a, &a], None), &["a.exr", "overlap"]);
     assert_error(
-        merge_files(&[&a, &other_seed], None),
+        merge(&[&a, &other_seed], None),
         &["a.exr", "seed2.exr", "seed", "'1' and '2'"],
     );
     assert_error(
-        merge_files(&[&a, &other_scene], None),
+        merge(&[&a, &other_scene], None),
         &["other_scene.exr", "sceneSha256"],
     );
-    assert_error(merge_files(&[&a, &b], Some(0..24)), &["0..16", "0..24"]);
-    assert_error(merge_files(&[], None), &["no parts"]);
+    assert_error(merge(&[&a, &b], Some(0..24)), &["0..16", "0..24"]);
+    assert_error(merge(&[], None), &["no parts"]);
 
     // Files that are not parts.
     let plain = d.join("plain.exr");
     write_image(&plain, &Image::new(SIZE, SIZE)).unwrap();
     assert_error(
-        merge_files(&[&plain], None),
+        merge(&[&plain], None),
         &["plain.exr", "gridtrace/record", "not a gridtrace render"],
     );
     let text = d.join("text.exr");
     std::fs::write(&text, "not an image").unwrap();
-    assert_error(merge_files(&[&text], None), &["text.exr", "OpenEXR"]);
+    assert_error(merge(&[&text], None), &["text.exr", "OpenEXR"]);
     let missing = d.join("missing.exr");
-    assert_error(merge_files(&[&missing], None), &["missing.exr"]);
+    assert_error(merge(&[&missing], None), &["missing.exr"]);
     let mut nan = Image::new(SIZE, SIZE);
     nan.pixels[5].y = f32::NAN;
     nan.spp = 8;
     let damaged = d.join("damaged.exr");
     write_image_with_record(&damaged, &nan, Some(&record(0..8, 1))).unwrap();
-    assert_error(
-        merge_files(&[&damaged], None),
-        &["damaged.exr", "pixel (5, 0)"],
-    );
+    assert_error(merge(&[&damaged], None), &["damaged.exr", "pixel (5, 0)"]);
     let mut small = record(0..8, 1);
     small.identity.width = SIZE / 2;
     let wrong_size = part(d, "wrong_size.exr", small);
     assert_error(
-        merge_files(&[&wrong_size], None),
+        merge(&[&wrong_size], None),
         &["wrong_size.exr", "16x32", "32x32"],
     );
 }
@@ -212,7 +205,9 @@ fn gridtrace(args: &[&str], cwd: &Path) -> Output {
 }
 
 fn read(path: &Path) -> Image {
-    read_part(path).unwrap_or_else(|e| panic!("{e}")).image
+    read_part(path)
+        .and_then(|part| part.read_image())
+        .unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
@@ -258,6 +253,19 @@ fn the_command_line_splits_and_merges() {
     let (whole, merged) = (read(&d.join("whole.exr")), read(&d.join("merged.exr")));
     assert_eq!(merged.alpha, whole.alpha);
     assert!(relative_difference(&merged, &whole) <= MERGE_TOLERANCE);
+
+    // A merged image is itself a part: later samples refine it.
+    run(&["--seed", "9", "--spp", "20", "-o", "whole20.exr"]);
+    run(&["--seed", "9", "--samples", "12..20", "-o", "more.exr"]);
+    let out = gridtrace(&["merge", "more.exr", "merged.exr", "-o", "refined.exr"], d);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (whole20, refined) = (read(&d.join("whole20.exr")), read(&d.join("refined.exr")));
+    assert_eq!(refined.samples(), 0..20);
+    assert!(relative_difference(&refined, &whole20) <= MERGE_TOLERANCE);
 
     // The record holds what the merge checks: another seed is refused.
     run(&["--samples", "12..16", "--seed", "10", "-o", "seed10.exr"]);
