@@ -1,17 +1,12 @@
 //! The `gridtrace` command as a user runs it.
 
+mod binary;
 mod common;
 
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn gridtrace(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gridtrace"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("run gridtrace")
-}
+use binary::gridtrace;
 
 fn asset(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))

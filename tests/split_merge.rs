@@ -2,9 +2,12 @@
 //! the stated f32 rounding bound; sets of parts that do not make one render are refused
 //! with messages that name the files.
 
+mod binary;
+
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+use binary::gridtrace;
 
 use gridtrace::load::load_scene;
 use gridtrace::merge::{MERGE_TOLERANCE, MergeError, merge_files, read_part};
@@ -194,14 +197,6 @@ fn bad_part_sets_are_refused_naming_the_parts() {
         merge(&[&wrong_size], None),
         &["wrong_size.exr", "16x32", "32x32"],
     );
-}
-
-fn gridtrace(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gridtrace"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("run gridtrace")
 }
 
 fn read(path: &Path) -> Image {
