@@ -105,6 +105,11 @@ pub struct Args {
     #[arg(long)]
     pub inspect: bool,
 
+    /// USD time code (Blender writes frame numbers) at which to read an animated USD stage:
+    /// transforms, points, cameras and lights. [default: the stage's startTimeCode]
+    #[arg(long, value_name = "FRAME", allow_negative_numbers = true, value_parser = parse_frame)]
+    pub frame: Option<f64>,
+
     /// What glTF light intensities mean: the specification's candela and lux (Blender's
     /// "Standard" export), or Blender's "Unitless" or "Raw" lighting modes.
     #[arg(long, value_enum, value_name = "UNITS", default_value = "standard")]
@@ -188,6 +193,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         .ok_or_else(|| anyhow!("no scene file given"))?;
     let options = LoadOptions {
         gltf_light_units: args.gltf_light_units,
+        usd_frame: args.frame,
     };
     if args.inspect {
         let loaded = load_scene_with(scene_path, &options)?;
@@ -385,7 +391,18 @@ fn load_options_label(options: &LoadOptions) -> String {
         .gltf_light_units
         .to_possible_value()
         .map_or_else(String::new, |v| v.get_name().to_string());
-    format!("gltf-light-units={units}")
+    match options.usd_frame {
+        Some(frame) => format!("gltf-light-units={units} usd-frame={frame}"),
+        None => format!("gltf-light-units={units}"),
+    }
+}
+
+/// A finite frame number (USD time code).
+fn parse_frame(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|f| f.is_finite())
+        .ok_or_else(|| format!("'{text}' is not a frame number"))
 }
 
 /// `SCENE_STEM.exr` in the current folder; `SCENE_STEM.samples-A-B.exr` for a part.
@@ -480,6 +497,18 @@ fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_frame_is_part_of_the_render_identity() {
+        let mut options = LoadOptions::default();
+        let still = load_options_label(&options);
+        options.usd_frame = Some(12.0);
+        let frame12 = load_options_label(&options);
+        options.usd_frame = Some(12.5);
+        assert_ne!(still, frame12);
+        assert_ne!(frame12, load_options_label(&options));
+        assert!(parse_frame("-3.5").is_ok() && parse_frame("inf").is_err());
+    }
 
     #[test]
     fn image_size_follows_the_camera_aspect() {

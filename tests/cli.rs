@@ -159,7 +159,7 @@ fn the_image_does_not_depend_on_the_thread_count() {
 #[test]
 fn errors_are_one_line_with_exit_code_2() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
         (&["missing.glb"], "missing.glb"),
         (&[&asset("cornell_box.glb"), "-o", "out.jpg"], "out.jpg"),
         (
@@ -169,6 +169,10 @@ fn errors_are_one_line_with_exit_code_2() {
         (
             &[&asset("cornell_box.glb"), "-o", "no/such/folder/x.png"],
             "x.png",
+        ),
+        (
+            &[&asset("cornell_box.glb"), "--frame", "12"],
+            "only USD animation",
         ),
     ];
     for (args, named) in cases {

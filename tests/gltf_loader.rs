@@ -433,6 +433,7 @@ fn punctual_lights_load_in_each_of_blenders_units() {
         let path = write_gltf(dir.path(), "lights.gltf", &doc);
         let options = LoadOptions {
             gltf_light_units: units,
+            ..LoadOptions::default()
         };
         let loaded = load_scene_with(&path, &options).unwrap();
         assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);

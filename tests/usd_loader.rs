@@ -672,3 +672,132 @@ fn references_and_instances_are_composed() {
         vec![Vec3::new(0.0, 7.0, 0.0), Vec3::new(5.0, 0.0, 0.0)]
     );
 }
+
+/// An animated stage, as Blender writes one: time-sampled transform, points, camera and
+/// light. Each is read at the frame asked for (linearly interpolated between samples), or
+/// at `startTimeCode` by default; attributes without samples keep their default.
+const ANIMATED: &str = r#"#usda 1.0
+(
+    upAxis = "Y"
+    metersPerUnit = 1
+    startTimeCode = 1
+    endTimeCode = 11
+)
+def Xform "Mover"
+{
+    double3 xformOp:translate.timeSamples = {
+        1: (0, 0, 0),
+        11: (10, 0, 0),
+    }
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+
+    def Mesh "Tri"
+    {
+        int[] faceVertexCounts = [3]
+        int[] faceVertexIndices = [0, 1, 2]
+        point3f[] points.timeSamples = {
+            1: [(0, 0, 0), (1, 0, 0), (0, 1, 0)],
+            11: [(0, 0, 0), (1, 0, 0), (0, 3, 0)],
+        }
+    }
+}
+def Camera "Cam"
+{
+    float focalLength.timeSamples = {
+        1: 50,
+        11: 25,
+    }
+    float horizontalAperture = 24
+    float verticalAperture = 24
+    double3 xformOp:translate = (0, 0, 10)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+}
+def SphereLight "Lamp"
+{
+    float inputs:intensity.timeSamples = {
+        1: 100.0,
+        11: 300.0,
+    }
+    float inputs:radius = 0.1
+    bool treatAsPoint = 1
+}
+"#;
+
+#[test]
+fn animated_stages_are_read_at_the_frame_asked_for() {
+    use gridtrace::load::{LoadOptions, load_scene_with};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("animated.usda");
+    std::fs::write(&path, ANIMATED).unwrap();
+    let at = |frame: Option<f64>| {
+        let options = LoadOptions {
+            usd_frame: frame,
+            ..LoadOptions::default()
+        };
+        let loaded = load_scene_with(&path, &options).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        loaded.scene
+    };
+    let apex = |scene: &Scene| world_triangles(scene, "/Mover/Tri")[0][2];
+    let fov = |scene: &Scene| match scene.cameras[0].projection {
+        Projection::Perspective { yfov, .. } => yfov,
+        ref other => panic!("{other:?}"),
+    };
+    let intensity = |scene: &Scene| match scene.lights[0].kind {
+        LightKind::Point { intensity, .. } => intensity.x,
+        ref other => panic!("{other:?}"),
+    };
+
+    let start = at(None);
+    assert!(
+        close(apex(&start), Vec3::new(0.0, 1.0, 0.0)),
+        "{}",
+        apex(&start)
+    );
+    let first = at(Some(1.0));
+    assert_eq!(apex(&first), apex(&start));
+    assert_eq!(fov(&first), fov(&start));
+
+    // Halfway: the transform and the points are interpolated.
+    let middle = at(Some(6.0));
+    assert!(
+        close(apex(&middle), Vec3::new(5.0, 2.0, 0.0)),
+        "{}",
+        apex(&middle)
+    );
+    // The last sample holds after the end.
+    let after = at(Some(20.0));
+    assert!(
+        close(apex(&after), Vec3::new(10.0, 3.0, 0.0)),
+        "{}",
+        apex(&after)
+    );
+    // Camera and light follow their samples too: half the focal length widens the view;
+    // three times the intensity triples the light.
+    let last = at(Some(11.0));
+    assert!(
+        fov(&last) > fov(&start) * 1.5,
+        "{} vs {}",
+        fov(&last),
+        fov(&start)
+    );
+    let ratio = intensity(&last) / intensity(&start);
+    assert!((ratio - 3.0).abs() < 1e-4, "{ratio}");
+    let ratio = intensity(&middle) / intensity(&start);
+    assert!((ratio - 2.0).abs() < 1e-4, "interpolated: {ratio}");
+}
+
+#[test]
+fn a_frame_for_a_gltf_scene_is_an_error() {
+    use gridtrace::load::{LoadOptions, load_scene_with};
+    let options = LoadOptions {
+        usd_frame: Some(3.0),
+        ..LoadOptions::default()
+    };
+    let err = load_scene_with(Path::new("assets/cornell_box.glb"), &options).unwrap_err();
+    let message = err.to_string();
+    assert!(
+        message.contains("cornell_box.glb") && message.contains("only USD animation"),
+        "{message}"
+    );
+}

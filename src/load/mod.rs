@@ -24,10 +24,13 @@ pub struct Loaded {
 }
 
 /// How to read what a file leaves to convention.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LoadOptions {
     /// Units of glTF punctual light intensities.
     pub gltf_light_units: GltfLightUnits,
+    /// The USD time code (frame) to read animated attributes at; `None`: the stage's
+    /// `startTimeCode`. Only USD animation is evaluated, so other formats refuse it.
+    pub usd_frame: Option<f64>,
 }
 
 /// What a glTF file's `KHR_lights_punctual` intensities mean. Blender's exporter offers all
@@ -89,14 +92,21 @@ fn load_by_format(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadErro
         .file_name()
         .map(|n| n.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
+    let is_usd = [".usd", ".usda", ".usdc", ".usdz"]
+        .iter()
+        .any(|e| name.ends_with(e));
+    if options.usd_frame.is_some() && !is_usd {
+        return Err(LoadError::Invalid {
+            path: path.to_path_buf(),
+            what: "a frame was asked for, but only USD animation is evaluated (glTF \
+                   animations are not read): export this frame as its own file"
+                .into(),
+        });
+    }
     if name.ends_with(".gltf") || name.ends_with(".glb") {
         gltf::load_with(path, options)
-    } else if name.ends_with(".usd")
-        || name.ends_with(".usda")
-        || name.ends_with(".usdc")
-        || name.ends_with(".usdz")
-    {
-        usd::load(path)
+    } else if is_usd {
+        usd::load_at(path, options.usd_frame)
     } else if name.ends_with(".ply") || name.ends_with(".ply.gz") {
         ply::load(path)
     } else {

@@ -31,11 +31,21 @@ const PROBE_DEADLINE: std::time::Duration = std::time::Duration::from_secs(120);
 /// Segments of the polygon a `DiskLight` becomes.
 const DISK_SEGMENTS: u32 = 48;
 
-/// Loads a USD stage. The USD reader is young third-party code: a panic inside it becomes an
-/// error naming the file instead of taking the program down.
+/// Loads a USD stage at its `startTimeCode`; see [`load_at`].
 pub fn load(path: &Path) -> Result<Loaded, LoadError> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_stage(path))).unwrap_or_else(
-        |panic| {
+    load_at(path, None)
+}
+
+/// Loads a USD stage as it is at time code `time` (Blender writes frame numbers), or at the
+/// stage's `startTimeCode` (0 if unauthored): every attribute with time samples — transforms,
+/// points, camera and light settings — is evaluated there, held or linearly interpolated
+/// as the stage says; attributes without samples read their default.
+///
+/// The USD reader is young third-party code: a panic inside it becomes an error naming the
+/// file instead of taking the program down.
+pub fn load_at(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_stage(path, time)))
+        .unwrap_or_else(|panic| {
             let why = panic
                 .downcast_ref::<String>()
                 .map(String::as_str)
@@ -45,8 +55,7 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
                 path: path.to_path_buf(),
                 what: format!("the USD reader failed: {why}"),
             })
-        },
-    )
+        })
 }
 
 /// Loads the stage once in a forked child first when the file may hold binary layers
@@ -55,7 +64,7 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
 /// than failing (found by fuzzing). Values are decoded lazily, so the child does the whole
 /// load. A child that dies that way becomes an error here.
 #[cfg(unix)]
-fn probe_binary_layers(path: &Path) -> Result<(), LoadError> {
+fn probe_binary_layers(path: &Path, time: Option<f64>) -> Result<(), LoadError> {
     let text = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("usda"));
@@ -66,7 +75,7 @@ fn probe_binary_layers(path: &Path) -> Result<(), LoadError> {
     // with `_exit`, running no destructors and touching nothing it shares with the parent.
     let pid = unsafe { libc::fork() };
     if pid == 0 {
-        let _ = std::panic::catch_unwind(|| read_stage(path).is_ok());
+        let _ = std::panic::catch_unwind(|| read_stage(path, time).is_ok());
         // SAFETY: ends the child at once, as fork's documentation asks.
         unsafe { libc::_exit(0) };
     }
@@ -107,16 +116,16 @@ fn probe_binary_layers(path: &Path) -> Result<(), LoadError> {
 }
 
 #[cfg(not(unix))]
-fn probe_binary_layers(_path: &Path) -> Result<(), LoadError> {
+fn probe_binary_layers(_path: &Path, _time: Option<f64>) -> Result<(), LoadError> {
     Ok(())
 }
 
-fn load_stage(path: &Path) -> Result<Loaded, LoadError> {
-    probe_binary_layers(path)?;
-    read_stage(path)
+fn load_stage(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
+    probe_binary_layers(path, time)?;
+    read_stage(path, time)
 }
 
-fn read_stage(path: &Path) -> Result<Loaded, LoadError> {
+fn read_stage(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
     let invalid = |what: String| LoadError::Invalid {
         path: path.to_path_buf(),
         what,
@@ -132,9 +141,11 @@ fn read_stage(path: &Path) -> Result<Loaded, LoadError> {
     }
     let stage =
         usd::Stage::open(name).map_err(|e| invalid(format!("cannot open USD stage: {e:#}")))?;
+    let time = usd::TimeCode::new(time.unwrap_or_else(|| stage.start_time_code()));
     let mut loader = UsdLoader {
         path: path.to_path_buf(),
         stage,
+        time,
         builder: SceneBuilder::new(),
         materials: HashMap::new(),
         default_material: None,
@@ -173,6 +184,8 @@ fn read_stage(path: &Path) -> Result<Loaded, LoadError> {
 struct UsdLoader {
     path: PathBuf,
     stage: usd::Stage,
+    /// When every attribute is read.
+    time: usd::TimeCode,
     builder: SceneBuilder,
     /// Our material index for each bound USD material prim path.
     materials: HashMap<String, usize>,
@@ -202,18 +215,30 @@ impl openusd::schemas::geom::Imageable for AnyXformable {}
 
 impl openusd::schemas::geom::Xformable for AnyXformable {}
 
-/// A value read from the stage, whatever its precision.
-fn value(stage: &usd::Stage, prim: &sdf::Path, name: &str) -> Option<sdf::Value> {
+/// A value read from the stage at `time`, whatever its precision.
+fn value(
+    stage: &usd::Stage,
+    prim: &sdf::Path,
+    name: &str,
+    time: usd::TimeCode,
+) -> Option<sdf::Value> {
     let path = prim.append_property(name).ok()?;
-    stage.attribute(path).get::<sdf::Value>().ok().flatten()
+    stage
+        .attribute(path)
+        .get_at::<sdf::Value>(time)
+        .ok()
+        .flatten()
 }
 
+/// A scalar as f64. Whole numbers count: openusd 0.6 reads a `.usda` time sample written
+/// `50` as an Int64 whatever the attribute's declared type.
 fn as_f64(v: &sdf::Value) -> Option<f64> {
     match v {
         sdf::Value::Double(d) => Some(*d),
         sdf::Value::Float(f) => Some(*f as f64),
         sdf::Value::Half(h) => Some(h.to_f32() as f64),
         sdf::Value::Int(i) => Some(*i as f64),
+        sdf::Value::Int64(i) => Some(*i as f64),
         _ => None,
     }
 }
@@ -308,7 +333,7 @@ impl UsdLoader {
     }
 
     fn get(&self, prim: &sdf::Path, name: &str) -> Option<sdf::Value> {
-        value(&self.stage, prim, name)
+        value(&self.stage, prim, name, self.time)
     }
 
     fn get_f32(&self, prim: &sdf::Path, name: &str) -> Option<f32> {
@@ -357,9 +382,8 @@ impl UsdLoader {
     fn local_transform(&mut self, prim: &usd::Prim) -> Result<(Mat4, bool), LoadError> {
         use openusd::schemas::geom::Xformable;
         let xform = AnyXformable(prim.clone());
-        let time = usd::TimeCode::new(self.stage.start_time_code());
         let m = xform
-            .local_to_parent_transform(time)
+            .local_to_parent_transform(self.time)
             .map_err(|e| self.invalid(format!("{}: {e:#}", prim.path().as_str())))?;
         let resets = xform.resets_xform_stack().unwrap_or(false);
         // USD's row-vector matrices, stored row by row, are glam's column-vector matrices
@@ -444,7 +468,7 @@ impl UsdLoader {
     {
         let attr_path = prim.append_property(name).ok()?;
         let attribute = self.stage.attribute(attr_path);
-        let raw = attribute.get::<sdf::Value>().ok().flatten()?;
+        let raw = attribute.get_at::<sdf::Value>(self.time).ok().flatten()?;
         let mut values = convert(&raw)?;
         // Indexed primvars: values[indices[i]].
         if let Some(indices) = self
