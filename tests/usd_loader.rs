@@ -801,3 +801,69 @@ fn a_frame_for_a_gltf_scene_is_an_error() {
         "{message}"
     );
 }
+
+/// Blender's own animation export (tools/blender/make_animated.py): a cube sliding 2 m, a
+/// camera zooming from 50 to 25 mm, a point light going from 100 to 300 W, one time
+/// sample per frame over 1–11. Read at the first, middle and last frame.
+#[test]
+fn blender_animation_is_read_at_each_frame() {
+    use gridtrace::load::{LoadOptions, load_scene_with};
+    let path = Path::new("tests/scenes/animated.usdc");
+    let at = |frame: Option<f64>| {
+        let options = LoadOptions {
+            usd_frame: frame,
+            ..LoadOptions::default()
+        };
+        let loaded = load_scene_with(path, &options).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        loaded.scene
+    };
+    let cube_centre = |scene: &Scene| {
+        let inst = scene
+            .instances
+            .iter()
+            .find(|i| i.source.contains("Mover"))
+            .expect("the cube");
+        let mesh = &scene.meshes[inst.mesh];
+        let sum: Vec3 = mesh
+            .positions
+            .iter()
+            .map(|p| inst.world_from_object.transform_point3(*p))
+            .sum();
+        sum / mesh.positions.len() as f32
+    };
+    let yfov_degrees = |scene: &Scene| match scene.cameras[0].projection {
+        Projection::Perspective { yfov, .. } => yfov.to_degrees(),
+        ref other => panic!("{other:?}"),
+    };
+    let watts = |scene: &Scene| match scene.lights[0].kind {
+        // Blender's point light of P watts is an intensity of P/(4π) W/sr.
+        LightKind::Point { intensity, .. } => intensity.x * 4.0 * std::f32::consts::PI,
+        ref other => panic!("{other:?}"),
+    };
+    // Vertical field of view of a 24 mm sensor: 2·atan(12 / focal length).
+    let fov = |focal: f32| (2.0 * (12.0 / focal).atan()).to_degrees();
+    for (frame, x, focal, power) in [
+        (None, 0.0, 50.0, 100.0),
+        (Some(1.0), 0.0, 50.0, 100.0),
+        (Some(6.0), 1.0, 37.5, 200.0),
+        (Some(11.0), 2.0, 25.0, 300.0),
+    ] {
+        let scene = at(frame);
+        let centre = cube_centre(&scene);
+        assert!(
+            (centre - Vec3::new(x, 0.25, 0.0)).abs().max_element() < 1e-4,
+            "{frame:?}: {centre}"
+        );
+        assert!(
+            (yfov_degrees(&scene) - fov(focal)).abs() < 0.01,
+            "{frame:?}: {}° for {focal} mm",
+            yfov_degrees(&scene)
+        );
+        assert!(
+            (watts(&scene) / power - 1.0).abs() < 1e-4,
+            "{frame:?}: {} W",
+            watts(&scene)
+        );
+    }
+}
