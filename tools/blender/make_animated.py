@@ -20,8 +20,13 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 OUT = os.path.join(ROOT, "tests", "scenes", "animated.usdc")
 
 
-def linear_keys(data_block):
-    """Linear interpolation between keys, so frame 6 is exactly halfway."""
+def animate(data_block, prop, first, last):
+    """Keys `prop` to `first` at frame 1 and `last` at frame 11, linearly in between, so
+    frame 6 is exactly halfway."""
+    setattr(data_block, prop, first)
+    data_block.keyframe_insert(prop, frame=1)
+    setattr(data_block, prop, last)
+    data_block.keyframe_insert(prop, frame=11)
     action = data_block.animation_data.action
     # Blender 4.4+ keeps F-curves in layered actions; older ones directly on the action.
     curves = []
@@ -46,10 +51,7 @@ def main():
     bpy.ops.mesh.primitive_cube_add(size=0.5, location=(0.0, 0.0, 0.25))
     cube = bpy.context.active_object
     cube.name = "Mover"
-    cube.keyframe_insert("location", frame=1)
-    cube.location.x = 2.0
-    cube.keyframe_insert("location", frame=11)
-    linear_keys(cube)
+    animate(cube, "location", (0.0, 0.0, 0.25), (2.0, 0.0, 0.25))
 
     bpy.ops.mesh.primitive_plane_add(size=1.0, location=(1.0, 0.0, 3.0))
     panel = bpy.context.active_object
@@ -62,12 +64,8 @@ def main():
     panel.data.materials.append(glow)
 
     light_data = bpy.data.lights.new("Lamp", type="POINT")
-    light_data.energy = 100.0
     light_data.shadow_soft_size = 0.0
-    light_data.keyframe_insert("energy", frame=1)
-    light_data.energy = 300.0
-    light_data.keyframe_insert("energy", frame=11)
-    linear_keys(light_data)
+    animate(light_data, "energy", 100.0, 300.0)
     lamp = bpy.data.objects.new("Lamp", light_data)
     lamp.location = (0.0, -1.0, 2.0)
     scene.collection.objects.link(lamp)
@@ -75,11 +73,7 @@ def main():
     camera_data = bpy.data.cameras.new("Camera")
     camera_data.sensor_fit = "VERTICAL"
     camera_data.sensor_height = 24.0
-    camera_data.lens = 50.0
-    camera_data.keyframe_insert("lens", frame=1)
-    camera_data.lens = 25.0
-    camera_data.keyframe_insert("lens", frame=11)
-    linear_keys(camera_data)
+    animate(camera_data, "lens", 50.0, 25.0)
     camera = bpy.data.objects.new("Camera", camera_data)
     camera.location = (1.0, -8.0, 1.0)
     camera.rotation_euler = (1.5708, 0.0, 0.0)
