@@ -14,7 +14,9 @@ use crate::inspect::describe;
 use crate::load::{GltfLightUnits, LoadOptions, load_scene_with};
 use crate::merge::merge_files;
 use crate::output::{Format, check_writable, write_image_with_record};
-use crate::record::{RenderIdentity, RenderRecord, format_range, parse_range, sha256_file};
+use crate::record::{
+    RenderIdentity, RenderRecord, format_range, parse_range, sha256_file, sha256_files,
+};
 use crate::render::{RenderSettings, Renderer, Strategy};
 use crate::scene::{Camera, Scene};
 
@@ -226,6 +228,12 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let scene_sha256 =
         sha256_file(scene_path).with_context(|| format!("{}", scene_path.display()))?;
     let loaded = load_scene_with(scene_path, &options)?;
+    let scene_dir = match scene_path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let dependencies_sha256 =
+        sha256_files(scene_dir, &loaded.files).context("hashing the files the scene reads")?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
@@ -317,6 +325,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         identity: RenderIdentity {
             version: env!("CARGO_PKG_VERSION").to_string(),
             scene_sha256,
+            dependencies_sha256,
             camera: camera_label(&camera),
             width,
             height,

@@ -38,6 +38,8 @@ pub struct RenderIdentity {
     pub version: String,
     /// SHA-256 of the scene file's bytes, as `sha256sum` prints it.
     pub scene_sha256: String,
+    /// SHA-256 over the other files the scene was read from ([`sha256_files`]).
+    pub dependencies_sha256: String,
     /// The camera's name and where it came from.
     pub camera: String,
     /// Image width in pixels.
@@ -87,10 +89,11 @@ impl RenderIdentity {
     }
 
     /// The identity as (attribute name, text) pairs, in a fixed order.
-    fn fields(&self) -> [(&'static str, String); 8] {
+    fn fields(&self) -> [(&'static str, String); 9] {
         [
             ("version", self.version.clone()),
             ("sceneSha256", self.scene_sha256.clone()),
+            ("dependenciesSha256", self.dependencies_sha256.clone()),
             ("camera", self.camera.clone()),
             ("width", self.width.to_string()),
             ("height", self.height.to_string()),
@@ -156,6 +159,7 @@ impl RenderRecord {
             identity: RenderIdentity {
                 version: text("version")?,
                 scene_sha256: text("sceneSha256")?,
+                dependencies_sha256: text("dependenciesSha256")?,
                 camera: text("camera")?,
                 width: small("width")?,
                 height: small("height")?,
@@ -228,6 +232,23 @@ pub fn sha256_file(path: &Path) -> io::Result<String> {
     Ok(Hex(&hasher.finalize()).to_string())
 }
 
+/// One SHA-256 for a set of files: of the lines `NAME<TAB>SHA256`, sorted, where NAME is
+/// the path relative to `base` (the scene's folder) when it lies inside, so the same files
+/// mounted elsewhere on another machine hash the same.
+pub fn sha256_files(base: &Path, files: &[std::path::PathBuf]) -> io::Result<String> {
+    let base = base.canonicalize()?;
+    let mut lines = files
+        .iter()
+        .map(|file| {
+            let file = file.canonicalize()?;
+            let name = file.strip_prefix(&base).unwrap_or(&file);
+            Ok(format!("{}\t{}\n", name.display(), sha256_file(&file)?))
+        })
+        .collect::<io::Result<Vec<String>>>()?;
+    lines.sort();
+    Ok(Hex(&Sha256::digest(lines.concat().as_bytes())).to_string())
+}
+
 /// Bytes as lowercase hex.
 struct Hex<'a>(&'a [u8]);
 
@@ -246,6 +267,7 @@ mod tests {
             identity: RenderIdentity {
                 version: "1.2.3".into(),
                 scene_sha256: "ab".repeat(32),
+                dependencies_sha256: "cd".repeat(32),
                 camera: "'Kamera \\ \"ü\"\nzwei' (glTF node 3)".into(),
                 width: 640,
                 height: 480,
@@ -263,7 +285,7 @@ mod tests {
     fn a_record_survives_its_text() {
         let record = record();
         let text = record.to_text();
-        assert_eq!(text.lines().count(), 11, "one line per field:\n{text}");
+        assert_eq!(text.lines().count(), 12, "one line per field:\n{text}");
         assert_eq!(RenderRecord::from_text(&text), Ok(record));
     }
 
@@ -307,6 +329,22 @@ mod tests {
             assert!(parse_range(bad).is_err(), "{bad}");
         }
         assert_eq!(format_range(&(3..9)), "3..9");
+    }
+
+    #[test]
+    fn a_set_of_files_hashes_by_name_and_content_wherever_it_lies() {
+        let hash_in = |dir: &Path, content: &[u8]| {
+            std::fs::create_dir_all(dir.join("textures")).unwrap();
+            std::fs::write(dir.join("scene.bin"), b"buffer").unwrap();
+            std::fs::write(dir.join("textures/wood.png"), content).unwrap();
+            let files = [dir.join("textures/wood.png"), dir.join("scene.bin")];
+            sha256_files(dir, &files).unwrap()
+        };
+        let root = tempfile::tempdir().unwrap();
+        let here = hash_in(&root.path().join("a"), b"wood");
+        assert_eq!(here, hash_in(&root.path().join("b/elsewhere"), b"wood"));
+        assert_ne!(here, hash_in(&root.path().join("c"), b"oak"));
+        assert!(sha256_files(root.path(), &[root.path().join("missing")]).is_err());
     }
 
     #[test]

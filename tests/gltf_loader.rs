@@ -551,3 +551,20 @@ fn blender_exported_lights_arrive_at_cycles_strengths() {
         other => panic!("{other:?}"),
     }
 }
+
+#[test]
+fn the_files_beside_a_gltf_are_listed() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut document = common::quad_document();
+    // An image that exists and one that does not (the latter only warns).
+    std::fs::write(dir.path().join("wood.png"), b"not decoded here").unwrap();
+    document["images"] = serde_json::json!([{"uri": "wood.png"}, {"uri": "gone%20missing.png"}]);
+    let path = common::write_gltf(dir.path(), "scene.gltf", &document);
+    let loaded = load_scene(&path).unwrap();
+    let names: Vec<_> = loaded
+        .files
+        .iter()
+        .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["quad.bin", "wood.png"]);
+}

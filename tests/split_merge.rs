@@ -3,6 +3,7 @@
 //! with messages that name the files.
 
 mod binary;
+mod common;
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -28,6 +29,7 @@ fn record(samples: Range<u32>, seed: u64) -> RenderRecord {
         identity: RenderIdentity {
             version: "test".into(),
             scene_sha256: "0".repeat(64),
+            dependencies_sha256: "0".repeat(64),
             camera: "'Camera'".into(),
             width: SIZE,
             height: SIZE,
@@ -276,4 +278,48 @@ fn the_command_line_splits_and_merges() {
     // --spp and --samples are two ways of saying how many samples: not both.
     let out = gridtrace(&[&scene, "--spp", "4", "--samples", "0..4"], d);
     assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn parts_read_from_different_buffer_files_do_not_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    common::write_gltf(d, "quad.gltf", &common::quad_document());
+    // Relative to the working folder, as users type it.
+    let scene = "quad.gltf";
+    let render = |samples: &str, out: &str| {
+        let out = gridtrace(
+            &[scene, "--width", "8", "-q", "--samples", samples, "-o", out],
+            d,
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    render("0..2", "a.exr");
+    render("2..4", "b.exr");
+    // The .gltf is untouched, but its buffer is re-exported with one corner moved.
+    let mut buffer = std::fs::read(d.join("quad.bin")).unwrap();
+    buffer[0] ^= 1;
+    std::fs::write(d.join("quad.bin"), buffer).unwrap();
+    render("2..4", "b_changed.exr");
+
+    let merge = |parts: &[&str]| {
+        let args: Vec<&str> = ["merge"]
+            .into_iter()
+            .chain(parts.iter().copied())
+            .chain(["-o", "merged.exr"])
+            .collect();
+        gridtrace(&args, d)
+    };
+    assert!(merge(&["a.exr", "b.exr"]).status.success());
+    let out = merge(&["a.exr", "b_changed.exr"]);
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{message}");
+    assert!(
+        message.contains("b_changed.exr") && message.contains("dependenciesSha256"),
+        "{message}"
+    );
 }

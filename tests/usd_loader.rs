@@ -657,6 +657,13 @@ fn references_and_instances_are_composed() {
     .unwrap();
     let loaded = load_scene(&main).unwrap();
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    // The referenced layer is a file the scene was read from; the stage itself is not.
+    let files: Vec<_> = loaded
+        .files
+        .iter()
+        .map(|f| f.file_name().unwrap())
+        .collect();
+    assert_eq!(files, ["part.usda"], "{:?}", loaded.files);
     let scene = &loaded.scene;
     let mut origins: Vec<Vec3> = scene
         .instances

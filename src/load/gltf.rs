@@ -115,7 +115,35 @@ pub fn load_bytes_with(
     Ok(Loaded {
         scene: loader.builder.build(),
         warnings: loader.warnings,
+        files: external_files(&document, base),
     })
+}
+
+/// The buffer and image files beside the glTF that it names (data URIs and the GLB blob
+/// are inside the file itself); missing ones are left out.
+fn external_files(document: &gltf::Document, base: &Path) -> Vec<PathBuf> {
+    let buffers = document.buffers().filter_map(|b| match b.source() {
+        gltf::buffer::Source::Uri(uri) => Some(uri),
+        gltf::buffer::Source::Bin => None,
+    });
+    let images = document.images().filter_map(|i| match i.source() {
+        gltf::image::Source::Uri { uri, .. } => Some(uri),
+        gltf::image::Source::View { .. } => None,
+    });
+    let mut files: Vec<PathBuf> = buffers
+        .chain(images)
+        .filter(|uri| !uri.starts_with("data:"))
+        .map(|uri| {
+            // glTF URIs percent-encode reserved characters (RFC 3986).
+            let decoded =
+                urlencoding::decode(uri).map_or_else(|_| uri.to_string(), |d| d.into_owned());
+            base.join(decoded)
+        })
+        .filter(|file| file.is_file())
+        .collect();
+    files.sort();
+    files.dedup();
+    files
 }
 
 /// `KHR_texture_transform`'s T · R · S. The rotation turns UVs clockwise in (u, v), i.e.

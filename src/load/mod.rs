@@ -9,7 +9,7 @@ pub mod usd;
 
 pub use error::LoadError;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::accel::Triangle;
 use crate::scene::Scene;
@@ -21,6 +21,9 @@ pub struct Loaded {
     pub scene: Scene,
     /// One line each, already naming what they concern.
     pub warnings: Vec<String>,
+    /// Other files the scene was read from (glTF buffers and images, USD layers and
+    /// textures), so a render's record can say exactly what it rendered.
+    pub files: Vec<PathBuf>,
 }
 
 /// How to read what a file leaves to convention.

@@ -240,6 +240,7 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
     Ok(Loaded {
         scene: builder.build(),
         warnings: Vec::new(),
+        files: Vec::new(),
     })
 }
 

@@ -151,6 +151,7 @@ fn read_stage(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
         default_material: None,
         one_sided: HashMap::new(),
         textures: HashMap::new(),
+        texture_paths: Vec::new(),
         from_blender: false,
         warnings: Vec::new(),
     };
@@ -175,9 +176,22 @@ fn read_stage(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
             .prim(format!("/{}", prim_name.as_str()).as_str());
         loader.visit(&prim, root, 0)?;
     }
+    // Layer identifiers are absolute; the stage's own file is not a dependency.
+    let own = path.canonicalize().ok();
+    let mut files: Vec<PathBuf> = loader
+        .stage
+        .layer_identifiers()
+        .into_iter()
+        .map(PathBuf::from)
+        .chain(loader.texture_paths)
+        .filter(|file| file.is_file() && file.canonicalize().ok() != own)
+        .collect();
+    files.sort();
+    files.dedup();
     Ok(Loaded {
         scene: loader.builder.build(),
         warnings: loader.warnings,
+        files,
     })
 }
 
@@ -194,6 +208,8 @@ struct UsdLoader {
     one_sided: HashMap<usize, usize>,
     /// Our texture for each image file tried (`None`: unreadable).
     textures: HashMap<String, Option<usize>>,
+    /// The image files tried, as paths.
+    texture_paths: Vec<PathBuf>,
     /// True for files Blender wrote, whose sun strengths follow Blender's convention.
     from_blender: bool,
     warnings: Vec<String>,
@@ -941,6 +957,7 @@ impl UsdLoader {
         }
         let base = self.path.parent().unwrap_or(Path::new("."));
         let full = base.join(file);
+        self.texture_paths.push(full.clone());
         let decoded = match image::open(&full) {
             Ok(image) => {
                 let rgba = image.to_rgba16();
