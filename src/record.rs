@@ -1,7 +1,7 @@
-//! What produced a rendered image: gridtrace's version, the scene file's SHA-256, the camera,
-//! size, seed and settings, and which samples of every pixel it holds. Every EXR gridtrace
-//! writes carries this record in its header, so images rendered apart — on other machines,
-//! at other times — can be checked and merged ([`crate::merge`]).
+//! What produced a rendered image: gridtrace's version, the SHA-256 of the scene and of the
+//! files it reads, the camera, size, seed and settings, and which samples of every pixel it
+//! holds. Every EXR gridtrace writes carries this record in its header, so images rendered
+//! apart — on other machines, at other times — can be checked and merged ([`crate::merge`]).
 //!
 //! The record is one text attribute, [`RECORD_ATTRIBUTE`], of `key=value` lines: the `exr`
 //! crate writes a header's attributes in hash-map order, so one attribute keeps the file's
@@ -50,7 +50,7 @@ pub struct RenderIdentity {
     pub seed: u64,
     /// Most scattering events along a path.
     pub max_depth: u32,
-    /// Loader options that change the scene, as text (glTF light units).
+    /// Loader options that change the scene, as text (glTF light units, USD frame).
     pub load_options: String,
 }
 
