@@ -7,7 +7,7 @@ use std::path::Path;
 
 use glam::Vec3;
 use gridtrace::cli::choose_camera;
-use gridtrace::load::{LoadError, load_scene};
+use gridtrace::load::{LoadError, LoadOptions, load_scene, load_scene_with};
 use gridtrace::scene::{Filter, LightKind, MaterialKind, Projection, Scene};
 use image_stats::{check_agreement, render_halves, render_scene_halves};
 
@@ -680,6 +680,17 @@ fn references_and_instances_are_composed() {
     );
 }
 
+/// The scene at `frame` (`None`: the stage's start), which must load without warnings.
+fn scene_at_frame(path: &Path, frame: Option<f64>) -> Scene {
+    let options = LoadOptions {
+        usd_frame: frame,
+        ..LoadOptions::default()
+    };
+    let loaded = load_scene_with(path, &options).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    loaded.scene
+}
+
 /// An animated stage, as Blender writes one: time-sampled transform, points, camera and
 /// light. Each is read at the frame asked for (linearly interpolated between samples), or
 /// at `startTimeCode` by default; attributes without samples keep their default.
@@ -732,19 +743,10 @@ def SphereLight "Lamp"
 
 #[test]
 fn animated_stages_are_read_at_the_frame_asked_for() {
-    use gridtrace::load::{LoadOptions, load_scene_with};
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("animated.usda");
     std::fs::write(&path, ANIMATED).unwrap();
-    let at = |frame: Option<f64>| {
-        let options = LoadOptions {
-            usd_frame: frame,
-            ..LoadOptions::default()
-        };
-        let loaded = load_scene_with(&path, &options).unwrap();
-        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
-        loaded.scene
-    };
+    let at = |frame| scene_at_frame(&path, frame);
     let apex = |scene: &Scene| world_triangles(scene, "/Mover/Tri")[0][2];
     let fov = |scene: &Scene| match scene.cameras[0].projection {
         Projection::Perspective { yfov, .. } => yfov,
@@ -796,7 +798,6 @@ fn animated_stages_are_read_at_the_frame_asked_for() {
 
 #[test]
 fn a_frame_for_a_gltf_scene_is_an_error() {
-    use gridtrace::load::{LoadOptions, load_scene_with};
     let options = LoadOptions {
         usd_frame: Some(3.0),
         ..LoadOptions::default()
@@ -814,17 +815,8 @@ fn a_frame_for_a_gltf_scene_is_an_error() {
 /// sample per frame over 1–11. Read at the first, middle and last frame.
 #[test]
 fn blender_animation_is_read_at_each_frame() {
-    use gridtrace::load::{LoadOptions, load_scene_with};
     let path = Path::new("tests/scenes/animated.usdc");
-    let at = |frame: Option<f64>| {
-        let options = LoadOptions {
-            usd_frame: frame,
-            ..LoadOptions::default()
-        };
-        let loaded = load_scene_with(path, &options).unwrap();
-        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
-        loaded.scene
-    };
+    let at = |frame| scene_at_frame(path, frame);
     let cube_centre = |scene: &Scene| {
         let inst = scene
             .instances
