@@ -31,6 +31,7 @@
 pub mod accel;
 pub mod cli;
 pub mod inspect;
+pub mod limits;
 pub mod load;
 pub mod merge;
 pub mod output;

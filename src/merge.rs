@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
+use crate::limits::check_memory;
 use crate::output::{read_exr_header, read_exr_rgba};
 use crate::record::{RECORD_ATTRIBUTE, RecordError, RenderRecord, format_range};
 use crate::render::{Image, PixelAccumulator};
@@ -26,6 +27,17 @@ pub const MERGE_TOLERANCE: f32 = 1.0 / (1u32 << 22) as f32;
 /// Parts bigger than this are refused before their pixels are read (a damaged header could
 /// otherwise ask for any amount of memory).
 const MAX_PART_PIXELS: usize = 1 << 28;
+
+/// Most a part's pixel data can be compressed: no lossless OpenEXR compression packs more
+/// than deflate's 1032:1 (ZIP; RLE reaches 64:1, PIZ's Huffman runs about 450:1), so a
+/// header whose pixels would need more than this many times the file's size is damaged.
+const MAX_COMPRESSION_RATIO: u64 = 2048;
+
+/// Bytes of RGBA f32 pixel data per pixel in a part.
+const PART_BYTES_PER_PIXEL: u64 = 16;
+
+/// Memory a merge holds per pixel: the accumulators, one part's pixels and the result.
+const MERGE_BYTES_PER_PIXEL: u64 = std::mem::size_of::<PixelAccumulator>() as u64 + 2 * 16;
 
 /// One rendered part as its header describes it; the pixels are read when needed
 /// ([`Part::read_image`]), so a merge holds one part's pixels at a time.
@@ -67,6 +79,9 @@ pub enum MergeError {
         /// What is wrong.
         message: String,
     },
+    /// The merge would need more memory than the run may use.
+    #[error("{0}")]
+    Memory(crate::limits::OverBudget),
     /// Two parts come from different renders.
     #[error(
         "{} and {} are not parts of one render: their {field} differs ('{ours}' and '{theirs}')",
@@ -164,9 +179,16 @@ pub fn read_part(path: &Path) -> Result<Part, MergeError> {
             header.width, header.height
         )));
     }
-    if header.width.saturating_mul(header.height) > MAX_PART_PIXELS {
+    let pixels = header.width.saturating_mul(header.height);
+    if pixels > MAX_PART_PIXELS {
         return Err(part(record).damaged(format!(
             "{width}x{height} is more pixels than gridtrace renders by default"
+        )));
+    }
+    let file_size = std::fs::metadata(path).map_or(0, |m| m.len());
+    if (pixels as u64).saturating_mul(PART_BYTES_PER_PIXEL) > file_size.saturating_mul(MAX_COMPRESSION_RATIO) {
+        return Err(part(record).damaged(format!(
+            "the header says {width}x{height} pixels, more than its {file_size} bytes can hold"
         )));
     }
     Ok(part(record))
@@ -287,6 +309,12 @@ pub fn merge_parts(
     }
 
     let identity = &first.record.identity;
+    let (width, height) = (identity.width, identity.height);
+    check_memory(
+        || format!("merging {width}x{height} parts"),
+        (width as u64 * height as u64).saturating_mul(MERGE_BYTES_PER_PIXEL),
+    )
+    .map_err(MergeError::Memory)?;
     let mut pixels =
         vec![PixelAccumulator::default(); identity.width as usize * identity.height as usize];
     for part in &order {

@@ -1,5 +1,6 @@
 //! Scene loaders: each turns one file format into a [`Scene`].
 
+pub mod access;
 mod error;
 pub mod gltf;
 mod images;
@@ -7,6 +8,7 @@ pub mod ply;
 mod tangents;
 pub mod usd;
 
+pub use access::AssetRoots;
 pub use error::LoadError;
 
 use std::path::{Path, PathBuf};
@@ -27,13 +29,15 @@ pub struct Loaded {
 }
 
 /// How to read what a file leaves to convention.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct LoadOptions {
     /// Units of glTF punctual light intensities.
     pub gltf_light_units: GltfLightUnits,
     /// The USD time code (frame) to read animated attributes at; `None`: the stage's
     /// `startTimeCode`. Only USD animation is evaluated, so other formats refuse it.
     pub usd_frame: Option<f64>,
+    /// Folders a scene may read besides its own (`--asset-path`); see [`access`].
+    pub asset_paths: Vec<PathBuf>,
 }
 
 /// What a glTF file's `KHR_lights_punctual` intensities mean. Blender's exporter offers all
@@ -109,7 +113,7 @@ fn load_by_format(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadErro
     if name.ends_with(".gltf") || name.ends_with(".glb") {
         gltf::load_with(path, options)
     } else if is_usd {
-        usd::load_at(path, options.usd_frame)
+        usd::load_with(path, options)
     } else if name.ends_with(".ply") || name.ends_with(".ply.gz") {
         ply::load(path)
     } else {

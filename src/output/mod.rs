@@ -82,16 +82,37 @@ pub fn write_image_with_record(
     write_atomically(path, &bytes)
 }
 
-/// Checks before a long render that `path` has a known format and that its folder accepts
-/// new files, so the render is not lost at the end.
+/// Checks before a long render (and before loading) that `path` has a known format, that
+/// its folder accepts new files, and that an existing file there may be replaced (not a
+/// directory, not immutable or read-only), so the render is not lost at the end.
 pub fn check_writable(path: &Path) -> Result<(), OutputError> {
     Format::from_path(path)?;
-    tempfile::NamedTempFile::new_in(parent_dir(path))
+    let fail = |message: String| OutputError::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    match std::fs::metadata(path) {
+        Ok(metadata) if metadata.is_dir() => {
+            return Err(fail("is a directory; name an image file".into()));
+        }
+        Ok(metadata) if !metadata.is_file() => {
+            return Err(fail("is not a regular file; name an image file".into()));
+        }
+        // An immutable (chattr +i) or read-only file refuses to be opened for writing;
+        // opening without truncating leaves it as it is.
+        Ok(_) => {
+            if let Err(e) = std::fs::OpenOptions::new().write(true).open(path) {
+                return Err(fail(format!("cannot replace the existing file: {e}")));
+            }
+        }
+        Err(_) => {}
+    }
+    tempfile::Builder::new()
+        .prefix(".gridtrace-")
+        .suffix(".tmp")
+        .tempfile_in(parent_dir(path))
         .map(drop)
-        .map_err(|e| OutputError::Write {
-            path: path.to_path_buf(),
-            message: format!("cannot write here: {e}"),
-        })
+        .map_err(|e| fail(format!("cannot write here: {e}")))
 }
 
 fn parent_dir(path: &Path) -> &Path {

@@ -136,6 +136,20 @@ impl<'a> Renderer<'a> {
         on_row: &(dyn Fn() + Sync),
         stop: &AtomicBool,
     ) -> (Image, RenderStats) {
+        self.render_with_checkpoints(camera, settings, on_row, stop, &mut |_| {})
+    }
+
+    /// [`Renderer::render_until`], calling `on_pass` after every pass but the last with a
+    /// function that makes the image of the samples so far, for checkpoints: `on_pass`
+    /// decides whether it is worth making.
+    pub fn render_with_checkpoints(
+        &self,
+        camera: &Camera,
+        settings: &RenderSettings,
+        on_row: &(dyn Fn() + Sync),
+        stop: &AtomicBool,
+        on_pass: &mut dyn FnMut(&dyn Fn() -> (Image, RenderStats)),
+    ) -> (Image, RenderStats) {
         let start = Instant::now();
         let generator = RayGenerator::new(camera, settings.width, settings.height);
         let width = settings.width as usize;
@@ -168,16 +182,36 @@ impl<'a> Renderer<'a> {
             if stop.load(Ordering::Relaxed) {
                 break;
             }
+            if stats.spp < spp {
+                on_pass(&|| resolve(&pixels, settings, stats, start));
+            }
         }
-        let mut image = Image::new(settings.width, settings.height);
-        image.spp = stats.spp;
-        image.first_sample = settings.first_sample;
-        for (i, acc) in pixels.iter().enumerate() {
-            (image.pixels[i], image.alpha[i]) = acc.resolve(stats.spp);
-            stats.nonfinite += acc.nonfinite as u64;
-        }
-        stats.samples = stats.spp as u64 * pixels.len() as u64;
-        stats.elapsed = start.elapsed();
-        (image, stats)
+        resolve(&pixels, settings, stats, start)
     }
+}
+
+/// The image of the samples in `pixels` so far, and the counters that go with it.
+fn resolve(
+    pixels: &[PixelAccumulator],
+    settings: &RenderSettings,
+    mut stats: RenderStats,
+    start: Instant,
+) -> (Image, RenderStats) {
+    let mut image = Image::new(settings.width, settings.height);
+    image.spp = stats.spp;
+    image.first_sample = settings.first_sample;
+    for (i, acc) in pixels.iter().enumerate() {
+        (image.pixels[i], image.alpha[i]) = acc.resolve(stats.spp);
+        stats.nonfinite += acc.nonfinite as u64;
+    }
+    stats.samples = stats.spp as u64 * pixels.len() as u64;
+    stats.elapsed = start.elapsed();
+    (image, stats)
+}
+
+/// Memory a render of `width`×`height` needs for its film: the accumulators, the image, and
+/// a second image and its encoding while a checkpoint or the output is written.
+pub fn film_bytes(width: u32, height: u32) -> u64 {
+    let per_pixel = std::mem::size_of::<PixelAccumulator>() as u64 + 3 * 16;
+    (width as u64 * height as u64).saturating_mul(per_pixel)
 }

@@ -37,6 +37,45 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// Why this camera cannot make an image, if it cannot: a field of view that is not
+    /// between 0 and 180°, an orthographic view of no size, or a transform that is not
+    /// finite or collapses a dimension (a zero matrix, a zero scale), all of which would
+    /// render a uniform image.
+    pub fn validate(&self) -> Result<(), String> {
+        match self.projection {
+            Projection::Perspective { yfov, aspect_ratio } => {
+                if !(yfov.is_finite() && yfov > 0.0 && yfov < std::f32::consts::PI) {
+                    return Err(format!(
+                        "vertical field of view {yfov} rad is not between 0 and π"
+                    ));
+                }
+                if let Some(a) = aspect_ratio.filter(|a| !(a.is_finite() && *a > 0.0)) {
+                    return Err(format!("aspect ratio {a} is not a positive number"));
+                }
+            }
+            Projection::Orthographic { xmag, ymag } => {
+                let positive = |m: f32| m.is_finite() && m != 0.0;
+                if !(positive(xmag) && positive(ymag)) {
+                    return Err(format!(
+                        "orthographic view {xmag}x{ymag} has no size (xmag and ymag must be non-zero)"
+                    ));
+                }
+            }
+        }
+        if !self.znear.is_finite() || self.znear < 0.0 {
+            return Err(format!("near clipping distance {} is not a finite, non-negative distance", self.znear));
+        }
+        let m = self.world_from_camera;
+        let determinant = m.matrix3.determinant();
+        if !(m.matrix3.is_finite() && m.translation.is_finite()) || determinant.abs() < 1e-12 {
+            return Err(
+                "its transform is not finite or is degenerate (a zero matrix or a zero scale)"
+                    .into(),
+            );
+        }
+        Ok(())
+    }
+
     /// The aspect ratio (width / height) this camera prefers, if it has one.
     pub fn aspect_ratio(&self) -> Option<f32> {
         match self.projection {

@@ -12,9 +12,13 @@ use glam::{Affine2, Affine3A, Mat4, Vec2, Vec3, Vec4};
 use gltf::json::validation::Validate;
 use gltf::mesh::Mode;
 
-use super::images::texture_from_image;
+mod files;
+
+use files::{SceneFiles, image_bytes, read_buffers};
+
+use super::images::decode_texture;
 use super::tangents::generate_tangents;
-use super::{GltfLightUnits, LoadError, LoadOptions, Loaded};
+use super::{AssetRoots, GltfLightUnits, LoadError, LoadOptions, Loaded};
 use crate::scene::{
     AlphaMode, Camera, Filter, Light, LightKind, Material, MaterialKind, MaterialTextures, Mesh,
     Projection, SceneBuilder, TextureRef, Wrap,
@@ -84,12 +88,12 @@ pub fn load_bytes_with(
     let mut warnings = Vec::new();
     check_extensions(path, &document, &mut warnings)?;
     validate(&document).map_err(gltf_error)?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = gltf::import_buffers(&document, Some(base), blob)
-        .map_err(|e| gltf_error(format!("loading buffers: {e}")))?;
+    let mut files = SceneFiles::new(path, AssetRoots::for_scene(path, &options.asset_paths));
+    let buffers = read_buffers(&document, blob, &mut files)?;
     let mut loader = GltfLoader {
         path: path.to_path_buf(),
         buffers,
+        files,
         builder: SceneBuilder::new(),
         meshes: HashMap::new(),
         default_material: None,
@@ -100,7 +104,7 @@ pub fn load_bytes_with(
         coloured_materials: HashSet::new(),
         warnings,
     };
-    loader.warn_about_missing_images(&document, base);
+    loader.warn_about_unreadable_images(&document);
     for material in document.materials() {
         let m = loader.convert_material(&material);
         loader
@@ -112,38 +116,13 @@ pub fn load_bytes_with(
     for &m in &loader.coloured_materials {
         loader.builder.material_mut(m).vertex_colours = true;
     }
+    let mut files = loader.files.read;
+    files.sort();
     Ok(Loaded {
         scene: loader.builder.build(),
         warnings: loader.warnings,
-        files: external_files(&document, base),
+        files,
     })
-}
-
-/// The buffer and image files beside the glTF that it names (data URIs and the GLB blob
-/// are inside the file itself); missing ones are left out.
-fn external_files(document: &gltf::Document, base: &Path) -> Vec<PathBuf> {
-    let buffers = document.buffers().filter_map(|b| match b.source() {
-        gltf::buffer::Source::Uri(uri) => Some(uri),
-        gltf::buffer::Source::Bin => None,
-    });
-    let images = document.images().filter_map(|i| match i.source() {
-        gltf::image::Source::Uri { uri, .. } => Some(uri),
-        gltf::image::Source::View { .. } => None,
-    });
-    let mut files: Vec<PathBuf> = buffers
-        .chain(images)
-        .filter(|uri| !uri.starts_with("data:"))
-        .map(|uri| {
-            // glTF URIs percent-encode reserved characters (RFC 3986).
-            let decoded =
-                urlencoding::decode(uri).map_or_else(|_| uri.to_string(), |d| d.into_owned());
-            base.join(decoded)
-        })
-        .filter(|file| file.is_file())
-        .collect();
-    files.sort();
-    files.dedup();
-    files
 }
 
 /// `KHR_texture_transform`'s T · R · S. The rotation turns UVs clockwise in (u, v), i.e.
@@ -240,6 +219,8 @@ fn validate(document: &gltf::Document) -> Result<(), String> {
 struct GltfLoader {
     path: PathBuf,
     buffers: Vec<gltf::buffer::Data>,
+    /// External files: what may be read, and what was.
+    files: SceneFiles,
     builder: SceneBuilder,
     /// Our mesh indices for each glTF mesh, one per triangle primitive, made on first use.
     meshes: HashMap<usize, Vec<usize>>,
@@ -247,7 +228,7 @@ struct GltfLoader {
     light_units: GltfLightUnits,
     /// Our texture index for each glTF image tried so far (`None`: unusable).
     images: HashMap<usize, Option<usize>>,
-    /// Images whose external file does not exist (already warned about).
+    /// Images whose external file cannot be read (already warned about).
     missing_images: HashSet<usize>,
     /// For each glTF material: the texture-coordinate set its normal map uses, if any.
     normal_mapped: Vec<Option<usize>>,
@@ -445,17 +426,13 @@ impl GltfLoader {
         );
         let decoded = if self.missing_images.contains(&image.index()) {
             None
-        } else if let Err(why) = self.check_image_view(image) {
-            self.warn(format!("{name}: {why}; using a neutral texture"));
-            None
         } else {
-            let base = self.path.parent().unwrap_or(Path::new(".")).to_path_buf();
-            match gltf::image::Data::from_source(image.source(), Some(&base), &self.buffers) {
-                Ok(data) => Some(self.builder.add_texture(texture_from_image(name, &data))),
-                Err(e) => {
-                    self.warn(format!(
-                        "{name} cannot be decoded ({e}); using a neutral texture"
-                    ));
+            match image_bytes(image, &self.buffers, &mut self.files)
+                .and_then(|bytes| decode_texture(name.clone(), &bytes))
+            {
+                Ok(texture) => Some(self.builder.add_texture(texture)),
+                Err(why) => {
+                    self.warn(format!("{name}: {why}; using a neutral texture"));
                     None
                 }
             }
@@ -464,43 +441,19 @@ impl GltfLoader {
         decoded
     }
 
-    /// An image in a buffer view must lie inside its buffer (the gltf crate would index past
-    /// it).
-    fn check_image_view(&self, image: &gltf::Image) -> Result<(), String> {
-        if let gltf::image::Source::View { view, .. } = image.source() {
-            let buffer = self
-                .buffers
-                .get(view.buffer().index())
-                .map_or(0, |b| b.0.len());
-            let end = view.offset().checked_add(view.length());
-            if end.is_none_or(|end| end > buffer) {
-                return Err(format!(
-                    "buffer view {} runs past its buffer ({buffer} bytes)",
-                    view.index()
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    /// A missing image file is worth one clear warning, whether or not a texture uses it.
-    fn warn_about_missing_images(&mut self, document: &gltf::Document, base: &Path) {
+    /// An image file that cannot be read (missing, or refused by the file-access policy)
+    /// is worth one clear warning, whether or not a texture uses it.
+    fn warn_about_unreadable_images(&mut self, document: &gltf::Document) {
         for image in document.images() {
             if let gltf::image::Source::Uri { uri, .. } = image.source()
-                && !uri.starts_with("data:")
+                && !uri.get(..5).is_some_and(|s| s.eq_ignore_ascii_case("data:"))
+                && let Err(why) = self.files.resolve(uri)
             {
-                // glTF URIs percent-encode reserved characters (RFC 3986).
-                let decoded =
-                    urlencoding::decode(uri).map_or_else(|_| uri.to_string(), |d| d.into_owned());
-                let file = base.join(decoded);
-                if !file.is_file() {
-                    self.missing_images.insert(image.index());
-                    self.warn(format!(
-                        "image {} not found: {}",
-                        image.index(),
-                        file.display()
-                    ));
-                }
+                self.missing_images.insert(image.index());
+                self.warn(format!(
+                    "image {}: {why}; using a neutral texture",
+                    image.index()
+                ));
             }
         }
     }
@@ -827,15 +780,17 @@ impl GltfLoader {
                 accessor.index()
             )));
         }
-        let needed = match accessor.count() {
+        // In u128: counts and offsets come from the file and may be anything up to 2^64.
+        let needed = match accessor.count() as u128 {
             0 => 0,
-            n => accessor.offset() + stride * (n - 1) + element,
+            n => accessor.offset() as u128 + stride as u128 * (n - 1) + element as u128,
         };
         let buffer_len = self
             .buffers
             .get(view.buffer().index())
             .map_or(0, |b| b.0.len());
-        if needed > view.length() || view.offset() + view.length() > buffer_len {
+        let view_end = view.offset() as u128 + view.length() as u128;
+        if needed > view.length() as u128 || view_end > buffer_len as u128 {
             return Err(self.invalid(format!(
                 "{name}: accessor {} needs {needed} bytes but buffer view {} holds {} (buffer {} has {buffer_len})",
                 accessor.index(),

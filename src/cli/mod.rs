@@ -1,181 +1,52 @@
 //! The command-line driver: parse arguments, load, render, write; or merge parts rendered
-//! apart. Errors exit with code 2.
+//! apart. Errors exit with code 2; a render stopped by a signal writes the image so far
+//! and exits with 128 + the signal's number ([`signals`]).
+
+mod args;
+pub mod signals;
+
+pub use args::{Args, Command, MergeArgs};
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::inspect::describe;
-use crate::load::{GltfLightUnits, LoadOptions, load_scene_with};
+use crate::limits::{check_memory, set_memory_budget};
+use crate::load::{LoadOptions, load_scene_with};
 use crate::merge::merge_files;
 use crate::output::{Format, check_writable, write_image_with_record};
-use crate::record::{
-    RenderIdentity, RenderRecord, format_range, parse_range, sha256_file, sha256_files,
-};
-use crate::render::{RenderSettings, Renderer, Strategy};
+use crate::record::{RenderIdentity, RenderRecord, format_range, sha256_file, sha256_files};
+use crate::render::{Image, RenderSettings, RenderStats, Renderer, Strategy, film_bytes};
 use crate::scene::{Camera, Scene};
+use signals::{Phase, output_lock, set_phase};
 
 /// Image height used when neither --width nor --height is given.
 const DEFAULT_HEIGHT: u32 = 512;
-
-/// Render a glTF 2.0 (.gltf, .glb), USD (.usd, .usda, .usdc, .usdz) or PLY scene with a
-/// physically based path tracer.
-///
-/// Emissive materials are area lights; metallic materials are ideal mirrors; transmissive
-/// materials are ideal glass; everything else is Lambertian. Output is linear float
-/// OpenEXR (.exr) or 8-bit sRGB PNG (.png), chosen by the output file's extension.
-///
-/// A long render can be split: `--samples A..B` renders only those samples of every pixel,
-/// and `gridtrace merge` combines the parts into the image of one render.
-#[derive(Parser, Debug)]
-#[command(
-    name = "gridtrace",
-    version,
-    about,
-    long_about,
-    args_conflicts_with_subcommands = true,
-    subcommand_negates_reqs = true
-)]
-pub struct Args {
-    /// Something other than rendering.
-    #[command(subcommand)]
-    pub command: Option<Command>,
-
-    /// Scene file to render (.gltf, .glb, .usd, .usda, .usdc, .usdz, .ply, .ply.gz).
-    #[arg(required = true)]
-    pub scene: Option<PathBuf>,
-
-    /// Output image, .exr (linear float RGBA) or .png (sRGB). [default: SCENE_STEM.exr in the current folder]
-    #[arg(short, long, value_name = "FILE")]
-    pub output: Option<PathBuf>,
-
-    /// Samples per pixel: more means less noise and a longer render.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
-    pub spp: u32,
-
-    /// Render only samples A to B−1 of every pixel, as one part of a render split across
-    /// processes or machines; `gridtrace merge` combines the parts (write them as .exr).
-    /// Any sample is the same whichever process renders it. [instead of --spp]
-    #[arg(long, value_name = "A..B", value_parser = parse_range, conflicts_with = "spp")]
-    pub samples: Option<Range<u32>>,
-
-    /// Image width in pixels. [default: from --height and the camera's aspect ratio]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub width: Option<u32>,
-
-    /// Image height in pixels. [default: 512, or from --width and the camera's aspect ratio]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub height: Option<u32>,
-
-    /// Most bounces along a path; 0 shows emitters only, 1 direct light only.
-    #[arg(long, default_value_t = 16)]
-    pub max_depth: u32,
-
-    /// Random seed: the same seed gives a bit-identical image, whatever the thread count.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-
-    /// Worker threads. [default: one per core]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
-
-    /// Camera to render, by name or by index in file order. [default: the first camera, or
-    /// one that frames the whole scene if the file has none]
-    #[arg(long, value_name = "NAME|INDEX")]
-    pub camera: Option<String>,
-
-    /// No progress bar and no summary; warnings and errors are still printed.
-    #[arg(short, long)]
-    pub quiet: bool,
-
-    /// Refuse scenes with more triangles than this (after instancing), before building
-    /// anything; raise it to render bigger scenes.
-    #[arg(long, value_name = "N", default_value_t = 200_000_000)]
-    pub max_triangles: u64,
-
-    /// Refuse images with more pixels than this; raise it to render bigger images.
-    #[arg(long, value_name = "N", default_value_t = 1 << 28)]
-    pub max_pixels: u64,
-
-    /// Print what was loaded (meshes, materials and how they were mapped, textures, lights
-    /// with their power, cameras, warnings) and exit without rendering.
-    #[arg(long)]
-    pub inspect: bool,
-
-    /// USD time code (Blender writes frame numbers) at which to read an animated USD stage:
-    /// transforms, points, cameras and lights. [default: the stage's startTimeCode]
-    #[arg(long, value_name = "FRAME", allow_negative_numbers = true, value_parser = parse_frame)]
-    pub frame: Option<f64>,
-
-    /// What glTF light intensities mean: the specification's candela and lux (Blender's
-    /// "Standard" export), or Blender's "Unitless" or "Raw" lighting modes.
-    #[arg(long, value_enum, value_name = "UNITS", default_value = "standard")]
-    pub gltf_light_units: GltfLightUnits,
-}
-
-/// Commands other than rendering.
-#[derive(Subcommand, Debug)]
-pub enum Command {
-    /// Combine EXR parts of one render (rendered with --samples) into one image, equal to
-    /// the render of all their samples by one process.
-    Merge(MergeArgs),
-}
-
-/// Arguments of `gridtrace merge`.
-#[derive(clap::Args, Debug)]
-pub struct MergeArgs {
-    /// The parts: EXR files written by `gridtrace SCENE --samples A..B`, in any order.
-    #[arg(required = true, value_name = "PART")]
-    pub parts: Vec<PathBuf>,
-
-    /// The merged image, .exr (which can be merged again) or .png.
-    #[arg(short, long, value_name = "FILE")]
-    pub output: PathBuf,
-
-    /// Fail unless the parts hold exactly these samples, so a missing part is an error
-    /// rather than a noisier image. [default: any contiguous range]
-    #[arg(long, value_name = "A..B", value_parser = parse_range)]
-    pub samples: Option<Range<u32>>,
-
-    /// No summary; errors are still printed.
-    #[arg(short, long)]
-    pub quiet: bool,
-}
-
-/// Set by the first Ctrl-C: finish the current pass, write the image, exit with 130.
-static STOP: AtomicBool = AtomicBool::new(false);
 
 /// How a run ended, when it did not fail.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Outcome {
     /// All samples were taken and the image written.
     Completed,
-    /// Ctrl-C stopped the render early; the image written holds fewer samples.
+    /// A signal stopped the render early; the image written holds fewer samples.
     Interrupted,
 }
 
-/// Runs the command line and returns the process exit code: 0, 2 on errors, 130 (as for
-/// SIGINT) when Ctrl-C stopped the render and the partial image was written.
+/// Runs the command line and returns the process exit code: 0, 2 on errors, 128 + the
+/// signal's number (130 for Ctrl-C, 143 for SIGTERM) when a signal stopped the render and
+/// the partial image was written.
 pub fn main() -> i32 {
     let args = Args::parse();
-    // A second Ctrl-C quits at once, without writing.
-    let _ = ctrlc::set_handler(|| {
-        if STOP.swap(true, Ordering::SeqCst) {
-            eprintln!("\ninterrupted again: quitting without writing the image");
-            std::process::exit(130);
-        }
-        eprintln!(
-            "\ninterrupted: finishing the current pass, then writing the image (Ctrl-C again quits)"
-        );
-    });
-    match run(&args, &STOP) {
+    signals::install();
+    match run(&args, &signals::STOP) {
         Ok(Outcome::Completed) => 0,
-        Ok(Outcome::Interrupted) => 130,
+        Ok(Outcome::Interrupted) => signals::interrupted_exit_code(),
         Err(e) => {
             eprintln!("error: {e:#}");
             2
@@ -189,6 +60,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     if let Some(Command::Merge(merge)) = &args.command {
         return run_merge(merge).map(|()| Outcome::Completed);
     }
+    set_memory_budget(args.max_memory.unwrap_or(0));
     let scene_path = args
         .scene
         .as_deref()
@@ -196,7 +68,13 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let options = LoadOptions {
         gltf_light_units: args.gltf_light_units,
         usd_frame: args.frame,
+        asset_paths: args.asset_path.clone(),
     };
+    for dir in &args.asset_path {
+        if !dir.is_dir() {
+            bail!("{}: --asset-path is not a folder", dir.display());
+        }
+    }
     if args.inspect {
         let loaded = load_scene_with(scene_path, &options)?;
         print!(
@@ -211,7 +89,10 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         .output
         .clone()
         .unwrap_or_else(|| default_output(scene_path, args.samples.as_ref()));
-    check_writable(&output)?;
+    {
+        let _writing = output_lock();
+        check_writable(&output)?;
+    }
     if args.samples.is_some() && Format::from_path(&output)? != Format::Exr {
         eprintln!(
             "warning: {}: only .exr parts can be merged; a PNG keeps no record of its samples",
@@ -259,6 +140,9 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     }
 
     let camera = choose_camera(&scene, args.camera.as_deref(), args.width, args.height)?;
+    camera
+        .validate()
+        .map_err(|why| anyhow!("{}: camera {}: {why}", scene_path.display(), camera_label(&camera)))?;
     let (width, height) = image_size(args.width, args.height, camera.aspect_ratio());
     if width as u64 * height as u64 > args.max_pixels {
         bail!(
@@ -267,6 +151,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
             args.max_pixels
         );
     }
+    check_memory(|| format!("a {width}x{height} film"), film_bytes(width, height))?;
     if let (Some(w), Some(h), Some(aspect)) = (args.width, args.height, camera.aspect_ratio())
         && ((w as f32 / h as f32) / aspect - 1.0).abs() > 0.01
     {
@@ -302,10 +187,52 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
             load_start.elapsed().as_secs_f64()
         );
     }
+    let identity = RenderIdentity {
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        scene_sha256,
+        dependencies_sha256,
+        camera: camera_label(&camera),
+        width,
+        height,
+        seed: settings.seed,
+        max_depth: settings.max_depth,
+        load_options: load_options_label(&options),
+    };
+    let scene_name = scene_path
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let record_of = |image: &Image, stats: &RenderStats| RenderRecord {
+        identity: identity.clone(),
+        scene_name: scene_name.clone(),
+        samples: image.samples(),
+        nonfinite: stats.nonfinite,
+    };
     let bar = progress_bar(height as u64 * settings.spp as u64, args.quiet);
-    let (image, stats) =
-        pool.install(|| renderer.render_until(&camera, &settings, &|| bar.inc(1), stop));
+    // Checkpoints: the image so far, written as the output itself, every so often.
+    let every = args.checkpoint.map(Duration::from_secs_f64);
+    let mut last_checkpoint = Instant::now();
+    let mut checkpoint_error = None;
+    let mut on_pass = |image_so_far: &dyn Fn() -> (Image, RenderStats)| {
+        let Some(every) = every else { return };
+        if last_checkpoint.elapsed() < every || checkpoint_error.is_some() {
+            return;
+        }
+        let (image, stats) = image_so_far();
+        let _writing = output_lock();
+        if let Err(e) = write_image_with_record(&output, &image, Some(&record_of(&image, &stats)))
+        {
+            checkpoint_error = Some(e);
+        }
+        last_checkpoint = Instant::now();
+    };
+    set_phase(Phase::Rendering);
+    let (image, stats) = pool.install(|| {
+        renderer.render_with_checkpoints(&camera, &settings, &|| bar.inc(1), stop, &mut on_pass)
+    });
     bar.finish_and_clear();
+    if let Some(e) = checkpoint_error {
+        eprintln!("warning: a checkpoint could not be written: {e}");
+    }
     let interrupted = stats.spp < settings.spp;
     if interrupted {
         eprintln!(
@@ -321,25 +248,11 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
             stats.nonfinite
         );
     }
-    let record = RenderRecord {
-        identity: RenderIdentity {
-            version: env!("CARGO_PKG_VERSION").to_string(),
-            scene_sha256,
-            dependencies_sha256,
-            camera: camera_label(&camera),
-            width,
-            height,
-            seed: settings.seed,
-            max_depth: settings.max_depth,
-            load_options: load_options_label(&options),
-        },
-        scene_name: scene_path
-            .file_name()
-            .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
-        samples: image.samples(),
-        nonfinite: stats.nonfinite,
-    };
-    write_image_with_record(&output, &image, Some(&record))?;
+    {
+        let _writing = output_lock();
+        write_image_with_record(&output, &image, Some(&record_of(&image, &stats)))?;
+        set_phase(Phase::Finished);
+    }
     if !args.quiet {
         let seconds = stats.elapsed.as_secs_f64().max(1e-9);
         let range = match args.samples {
@@ -363,7 +276,11 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
 
 /// Reads, checks and merges the parts, and writes the merged image.
 fn run_merge(args: &MergeArgs) -> Result<()> {
-    check_writable(&args.output)?;
+    set_memory_budget(args.max_memory.unwrap_or(0));
+    {
+        let _writing = output_lock();
+        check_writable(&args.output)?;
+    }
     let start = Instant::now();
     let (image, record) = merge_files(&args.parts, args.samples.clone())?;
     if record.nonfinite > 0 {
@@ -372,7 +289,11 @@ fn run_merge(args: &MergeArgs) -> Result<()> {
             record.nonfinite
         );
     }
-    write_image_with_record(&args.output, &image, Some(&record))?;
+    {
+        let _writing = output_lock();
+        write_image_with_record(&args.output, &image, Some(&record))?;
+        set_phase(Phase::Finished);
+    }
     if !args.quiet {
         eprintln!(
             "merged {} part(s) of {} ({}x{}, camera {}): samples {} in {:.2} s; wrote {}",
@@ -404,14 +325,6 @@ fn load_options_label(options: &LoadOptions) -> String {
         Some(frame) => format!("gltf-light-units={units} usd-frame={frame}"),
         None => format!("gltf-light-units={units}"),
     }
-}
-
-/// A finite frame number (USD time code).
-fn parse_frame(text: &str) -> Result<f64, String> {
-    text.parse::<f64>()
-        .ok()
-        .filter(|f| f.is_finite())
-        .ok_or_else(|| format!("'{text}' is not a frame number"))
 }
 
 /// `SCENE_STEM.exr` in the current folder; `SCENE_STEM.samples-A-B.exr` for a part.
@@ -505,6 +418,7 @@ fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
 
 #[cfg(test)]
 mod tests {
+    use super::args::parse_frame;
     use super::*;
 
     #[test]

@@ -14,118 +14,72 @@ use std::path::{Path, PathBuf};
 use glam::{Affine2, Affine3A, Mat4, Vec2, Vec3};
 use openusd::{sdf, usd};
 
+mod probe;
+mod resolver;
+
+use resolver::{ConfinedResolver, Refusals};
+
+use super::images::decode_texture;
 use super::tangents::generate_tangents;
-use super::{LoadError, Loaded};
+use super::access::read_regular_file;
+use super::{AssetRoots, LoadError, LoadOptions, Loaded};
+use crate::limits::memory_budget;
 use crate::scene::{
     AlphaMode, Camera, ColorSpace, Light, LightKind, Material, MaterialKind, MaterialTextures,
-    Mesh, Projection, SceneBuilder, Texture, TextureRef, Wrap,
+    Mesh, Projection, SceneBuilder, TextureRef, Wrap,
 };
 
 /// Deepest prim hierarchy walked.
 const MAX_DEPTH: usize = 256;
 
-/// Longest the forked probe of a binary layer may take before it is given up on.
-#[cfg(unix)]
-const PROBE_DEADLINE: std::time::Duration = std::time::Duration::from_secs(120);
-
 /// Segments of the polygon a `DiskLight` becomes.
 const DISK_SEGMENTS: u32 = 48;
 
-/// Loads a USD stage at its `startTimeCode`; see [`load_at`].
+/// Loads a USD stage at its `startTimeCode` with default options; see [`load_with`].
 pub fn load(path: &Path) -> Result<Loaded, LoadError> {
-    load_at(path, None)
+    load_with(path, &LoadOptions::default())
 }
 
-/// Loads a USD stage as it is at time code `time` (Blender writes frame numbers), or at the
-/// stage's `startTimeCode` (0 if unauthored): every attribute with time samples — transforms,
-/// points, camera and light settings — is evaluated there, held or linearly interpolated
-/// as the stage says; attributes without samples read their default.
-///
-/// The USD reader is young third-party code: a panic inside it becomes an error naming the
-/// file instead of taking the program down.
+/// Loads a USD stage at time code `time` with default options; see [`load_with`].
 pub fn load_at(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_stage(path, time)))
-        .unwrap_or_else(|panic| {
-            let why = panic
-                .downcast_ref::<String>()
-                .map(String::as_str)
-                .or_else(|| panic.downcast_ref::<&str>().copied())
-                .unwrap_or("unknown failure");
-            Err(LoadError::Invalid {
-                path: path.to_path_buf(),
-                what: format!("the USD reader failed: {why}"),
-            })
-        })
-}
-
-/// Loads the stage once in a forked child first when the file may hold binary layers
-/// (`.usd`, `.usdc`, `.usdz`): openusd 0.6's binary reader trusts the counts it reads, and a
-/// corrupt count makes it request an impossible allocation, which aborts the process rather
-/// than failing (found by fuzzing). Values are decoded lazily, so the child does the whole
-/// load. A child that dies that way becomes an error here.
-#[cfg(unix)]
-fn probe_binary_layers(path: &Path, time: Option<f64>) -> Result<(), LoadError> {
-    let text = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("usda"));
-    if text {
-        return Ok(());
-    }
-    // SAFETY: fork has no preconditions; the child below only reads the file and leaves
-    // with `_exit`, running no destructors and touching nothing it shares with the parent.
-    let pid = unsafe { libc::fork() };
-    if pid == 0 {
-        let _ = std::panic::catch_unwind(|| read_stage(path, time).is_ok());
-        // SAFETY: ends the child at once, as fork's documentation asks.
-        unsafe { libc::_exit(0) };
-    }
-    if pid < 0 {
-        // No child to spare: read in-process as before.
-        return Ok(());
-    }
-    // Wait, but not forever: a child stuck on a lock another thread held at the fork would
-    // otherwise hang the load. After the deadline it is killed and the file read in-process.
-    let deadline = std::time::Instant::now() + PROBE_DEADLINE;
-    let mut status = 0;
-    let waited = loop {
-        // SAFETY: polls the child forked above, with a valid status pointer.
-        let waited = unsafe { libc::waitpid(pid, &mut status, libc::WNOHANG) };
-        if waited != 0 {
-            break waited;
-        }
-        if std::time::Instant::now() > deadline {
-            // SAFETY: signals and reaps our own child.
-            unsafe {
-                libc::kill(pid, libc::SIGKILL);
-                libc::waitpid(pid, &mut status, 0);
-            }
-            return Ok(());
-        }
-        std::thread::sleep(std::time::Duration::from_millis(2));
+    let options = LoadOptions {
+        usd_frame: time,
+        ..LoadOptions::default()
     };
-    if waited == pid && libc::WIFSIGNALED(status) {
-        return Err(LoadError::Invalid {
+    load_with(path, &options)
+}
+
+/// Loads a USD stage as it is at time code `options.usd_frame` (Blender writes frame
+/// numbers), or at the stage's `startTimeCode` (0 if unauthored): every attribute with time
+/// samples — transforms, points, camera and light settings — is evaluated there, held or
+/// linearly interpolated as the stage says; attributes without samples read their default.
+///
+/// Every layer and texture is read through the file-access policy ([`AssetRoots`]); a
+/// layer it refuses fails the load, naming the layer that asked and the path. The USD
+/// reader is young third-party code: the whole composition is first read in a forked child
+/// ([`probe::probe_stage`]), so an abort inside it becomes an error, and a panic inside it
+/// becomes an error naming the file instead of taking the program down.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError> {
+    let roots = AssetRoots::for_scene(path, &options.asset_paths);
+    let time = options.usd_frame;
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        probe::probe_stage(path, || read_stage(path, time, &roots).is_ok())?;
+        read_stage(path, time, &roots)
+    }))
+    .unwrap_or_else(|panic| {
+        let why = panic
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| panic.downcast_ref::<&str>().copied())
+            .unwrap_or("unknown failure");
+        Err(LoadError::Invalid {
             path: path.to_path_buf(),
-            what: format!(
-                "the USD reader crashed on this file (signal {}); it is probably corrupt",
-                libc::WTERMSIG(status)
-            ),
-        });
-    }
-    Ok(())
+            what: format!("the USD reader failed: {why}"),
+        })
+    })
 }
 
-#[cfg(not(unix))]
-fn probe_binary_layers(_path: &Path, _time: Option<f64>) -> Result<(), LoadError> {
-    Ok(())
-}
-
-fn load_stage(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
-    probe_binary_layers(path, time)?;
-    read_stage(path, time)
-}
-
-fn read_stage(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
+fn read_stage(path: &Path, time: Option<f64>, roots: &AssetRoots) -> Result<Loaded, LoadError> {
     let invalid = |what: String| LoadError::Invalid {
         path: path.to_path_buf(),
         what,
@@ -139,11 +93,21 @@ fn read_stage(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
             source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
         });
     }
-    let stage =
-        usd::Stage::open(name).map_err(|e| invalid(format!("cannot open USD stage: {e:#}")))?;
+    let refused = Refusals::default();
+    let refusal = |refused: &Refusals| {
+        let first = refused.lock().ok()?.first().cloned()?;
+        Some(invalid(first))
+    };
+    let stage = usd::Stage::builder()
+        .resolver(ConfinedResolver::new(roots.clone(), refused.clone()))
+        .open(name)
+        .map_err(|e| {
+            refusal(&refused).unwrap_or_else(|| invalid(format!("cannot open USD stage: {e:#}")))
+        })?;
     let time = usd::TimeCode::new(time.unwrap_or_else(|| stage.start_time_code()));
     let mut loader = UsdLoader {
         path: path.to_path_buf(),
+        roots: roots.clone(),
         stage,
         time,
         builder: SceneBuilder::new(),
@@ -176,6 +140,13 @@ fn read_stage(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
             .prim(format!("/{}", prim_name.as_str()).as_str());
         loader.visit(&prim, root, 0)?;
     }
+    if let Some(error) = refusal(&refused) {
+        return Err(error);
+    }
+    // Layers that could not be found or read drop their content: say so.
+    for error in loader.stage.composition_errors() {
+        loader.warn(format!("{error}; its content is left out"));
+    }
     // Layer identifiers are absolute; the stage's own file is not a dependency.
     let own = path.canonicalize().ok();
     let mut files: Vec<PathBuf> = loader
@@ -197,6 +168,8 @@ fn read_stage(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
 
 struct UsdLoader {
     path: PathBuf,
+    /// The folders its layers and textures may be read from.
+    roots: AssetRoots,
     stage: usd::Stage,
     /// When every attribute is read.
     time: usd::TimeCode,
@@ -536,10 +509,15 @@ impl UsdLoader {
         if points.is_empty() || counts.is_empty() {
             return Ok(());
         }
-        if counts.iter().any(|&c| c < 0) || counts.iter().sum::<i64>() != indices.len() as i64 {
+        if let Some((face, &count)) = counts.iter().enumerate().find(|(_, c)| **c < 0) {
             return Err(self.invalid(format!(
-                "{where_}: faceVertexCounts add up to {} but there are {} faceVertexIndices",
-                counts.iter().sum::<i64>(),
+                "{where_}: faceVertexCounts[{face}] is {count}, a negative corner count"
+            )));
+        }
+        let total: i128 = counts.iter().map(|&c| i128::from(c)).sum();
+        if total != indices.len() as i128 {
+            return Err(self.invalid(format!(
+                "{where_}: faceVertexCounts add up to {total} but there are {} faceVertexIndices",
                 indices.len()
             )));
         }
@@ -956,24 +934,20 @@ impl UsdLoader {
             return known;
         }
         let base = self.path.parent().unwrap_or(Path::new("."));
-        let full = base.join(file);
-        self.texture_paths.push(full.clone());
-        let decoded = match image::open(&full) {
-            Ok(image) => {
-                let rgba = image.to_rgba16();
-                let (width, height) = rgba.dimensions();
-                let texels = rgba.pixels().map(|p| p.0).collect();
-                Some(self.builder.add_texture(Texture {
-                    name: file.to_string(),
-                    width,
-                    height,
-                    texels,
-                }))
-            }
-            Err(e) => {
+        let bytes = self.roots.resolve(base, file).and_then(|full| {
+            self.texture_paths.push(full.clone());
+            read_regular_file(&full, file, memory_budget())
+        });
+        let decoded = match bytes
+            .map_err(|e| e.to_string())
+            .and_then(|bytes| {
+                decode_texture(file.to_string(), &bytes).map_err(|e| format!("'{file}' {e}"))
+            })
+        {
+            Ok(texture) => Some(self.builder.add_texture(texture)),
+            Err(why) => {
                 self.warn(format!(
-                    "{material}: texture {} cannot be read ({e}); using a neutral texture",
-                    full.display()
+                    "{material}: texture {why}; using a neutral texture"
                 ));
                 None
             }

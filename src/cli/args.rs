@@ -1,0 +1,170 @@
+//! The command line's arguments.
+
+use std::ops::Range;
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+
+use crate::limits::parse_size;
+use crate::load::GltfLightUnits;
+use crate::record::parse_range;
+
+/// Render a glTF 2.0 (.gltf, .glb), USD (.usd, .usda, .usdc, .usdz) or PLY scene with a
+/// physically based path tracer.
+///
+/// Emissive materials are area lights; metallic materials are ideal mirrors; transmissive
+/// materials are ideal glass; everything else is Lambertian. Output is linear float
+/// OpenEXR (.exr) or 8-bit sRGB PNG (.png), chosen by the output file's extension.
+///
+/// A long render can be split: `--samples A..B` renders only those samples of every pixel,
+/// and `gridtrace merge` combines the parts into the image of one render.
+#[derive(Parser, Debug)]
+#[command(
+    name = "gridtrace",
+    version,
+    about,
+    long_about,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
+pub struct Args {
+    /// Something other than rendering.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+
+    /// Scene file to render (.gltf, .glb, .usd, .usda, .usdc, .usdz, .ply, .ply.gz).
+    #[arg(required = true)]
+    pub scene: Option<PathBuf>,
+
+    /// Output image, .exr (linear float RGBA) or .png (sRGB). [default: SCENE_STEM.exr in the current folder]
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+
+    /// Samples per pixel: more means less noise and a longer render.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: u32,
+
+    /// Render only samples A to B−1 of every pixel, as one part of a render split across
+    /// processes or machines; `gridtrace merge` combines the parts (write them as .exr).
+    /// Any sample is the same whichever process renders it. [instead of --spp]
+    #[arg(long, value_name = "A..B", value_parser = parse_range, conflicts_with = "spp")]
+    pub samples: Option<Range<u32>>,
+
+    /// Image width in pixels. [default: from --height and the camera's aspect ratio]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub width: Option<u32>,
+
+    /// Image height in pixels. [default: 512, or from --width and the camera's aspect ratio]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub height: Option<u32>,
+
+    /// Most bounces along a path; 0 shows emitters only, 1 direct light only.
+    #[arg(long, default_value_t = 16)]
+    pub max_depth: u32,
+
+    /// Random seed: the same seed gives a bit-identical image, whatever the thread count.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+
+    /// Worker threads. [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+
+    /// Camera to render, by name or by index in file order. [default: the first camera, or
+    /// one that frames the whole scene if the file has none]
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub camera: Option<String>,
+
+    /// No progress bar and no summary; warnings and errors are still printed.
+    #[arg(short, long)]
+    pub quiet: bool,
+
+    /// Refuse scenes with more triangles than this (after instancing), before building
+    /// anything; raise it to render bigger scenes.
+    #[arg(long, value_name = "N", default_value_t = 200_000_000)]
+    pub max_triangles: u64,
+
+    /// Refuse images with more pixels than this; raise it to render bigger images.
+    #[arg(long, value_name = "N", default_value_t = 1 << 28)]
+    pub max_pixels: u64,
+
+    /// Print what was loaded (meshes, materials and how they were mapped, textures, lights
+    /// with their power, cameras, warnings) and exit without rendering.
+    #[arg(long)]
+    pub inspect: bool,
+
+    /// USD time code (Blender writes frame numbers) at which to read an animated USD stage:
+    /// transforms, points, cameras and lights. [default: the stage's startTimeCode]
+    #[arg(long, value_name = "FRAME", allow_negative_numbers = true, value_parser = parse_frame)]
+    pub frame: Option<f64>,
+
+    /// What glTF light intensities mean: the specification's candela and lux (Blender's
+    /// "Standard" export), or Blender's "Unitless" or "Raw" lighting modes.
+    #[arg(long, value_enum, value_name = "UNITS", default_value = "standard")]
+    pub gltf_light_units: GltfLightUnits,
+
+    /// Another folder the scene may read files from (USD libraries shared between scenes),
+    /// besides the scene file's own folder; repeatable. Nothing else is read.
+    #[arg(long, value_name = "DIR")]
+    pub asset_path: Vec<PathBuf>,
+
+    /// Most memory to use (bytes, or with K, M, G, T: "16G"); larger films, parts and
+    /// meshes are refused before they are allocated. [default: the machine's memory, or
+    /// the process's limit (ulimit -v) if lower]
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub max_memory: Option<u64>,
+
+    /// Every SECONDS, write the image so far to the output (atomically, as a part that
+    /// `gridtrace merge` accepts), so a killed render keeps its samples.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub checkpoint: Option<f64>,
+}
+
+/// Commands other than rendering.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Combine EXR parts of one render (rendered with --samples) into one image, equal to
+    /// the render of all their samples by one process.
+    Merge(MergeArgs),
+}
+
+/// Arguments of `gridtrace merge`.
+#[derive(clap::Args, Debug)]
+pub struct MergeArgs {
+    /// The parts: EXR files written by `gridtrace SCENE --samples A..B`, in any order.
+    #[arg(required = true, value_name = "PART")]
+    pub parts: Vec<PathBuf>,
+
+    /// The merged image, .exr (which can be merged again) or .png.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+
+    /// Fail unless the parts hold exactly these samples, so a missing part is an error
+    /// rather than a noisier image. [default: any contiguous range]
+    #[arg(long, value_name = "A..B", value_parser = parse_range)]
+    pub samples: Option<Range<u32>>,
+
+    /// No summary; errors are still printed.
+    #[arg(short, long)]
+    pub quiet: bool,
+
+    /// Most memory to use; see `gridtrace --help`.
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub max_memory: Option<u64>,
+}
+
+/// A finite frame number (USD time code).
+pub fn parse_frame(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|f| f.is_finite())
+        .ok_or_else(|| format!("'{text}' is not a frame number"))
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .ok_or_else(|| format!("'{text}' is not a positive number of seconds"))
+}

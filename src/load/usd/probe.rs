@@ -1,0 +1,73 @@
+//! A first read of the whole stage in a forked child, so that the USD reader's aborts become
+//! errors. openusd 0.6 trusts the counts it reads from binary layers, and a corrupt count
+//! makes it request an impossible allocation, which aborts the process rather than failing
+//! (found by fuzzing); a text layer may sublayer or reference such a binary layer, and
+//! composition opens references only when it reaches them, so the child does the whole
+//! load, not only the file named on the command line.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use crate::load::LoadError;
+
+/// Longest the probe may take before it is given up on (and the stage read in-process).
+const PROBE_DEADLINE: Duration = Duration::from_secs(120);
+
+/// Runs `load` in a forked child; a child killed by a signal (an abort, a stack overflow,
+/// the memory limit) becomes an error naming `path`. Without a child to spare, or if the
+/// child outlives the deadline, the caller's own read decides.
+#[cfg(unix)]
+pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadError> {
+    // SAFETY: fork has no preconditions; the child below only reads files and leaves with
+    // `_exit`, running no destructors and touching nothing it shares with the parent.
+    let pid = unsafe { libc::fork() };
+    if pid == 0 {
+        // SAFETY: prctl with PR_SET_PDEATHSIG takes a signal number: the child dies with
+        // its parent (a killed render leaves no stray reader behind).
+        #[cfg(target_os = "linux")]
+        unsafe {
+            libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL)
+        };
+        let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(load));
+        // SAFETY: ends the child at once, as fork's documentation asks.
+        unsafe { libc::_exit(0) };
+    }
+    if pid < 0 {
+        return Ok(());
+    }
+    // Wait, but not forever: a child stuck on a lock another thread held at the fork would
+    // otherwise hang the load. After the deadline it is killed and the file read in-process.
+    let deadline = Instant::now() + PROBE_DEADLINE;
+    let mut status = 0;
+    let waited = loop {
+        // SAFETY: polls the child forked above, with a valid status pointer.
+        let waited = unsafe { libc::waitpid(pid, &mut status, libc::WNOHANG) };
+        if waited != 0 {
+            break waited;
+        }
+        if Instant::now() > deadline {
+            // SAFETY: signals and reaps our own child.
+            unsafe {
+                libc::kill(pid, libc::SIGKILL);
+                libc::waitpid(pid, &mut status, 0);
+            }
+            return Ok(());
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    if waited == pid && libc::WIFSIGNALED(status) {
+        return Err(LoadError::Invalid {
+            path: path.to_path_buf(),
+            what: format!(
+                "the USD reader crashed on this stage or a layer it uses (signal {}); a layer is probably corrupt",
+                libc::WTERMSIG(status)
+            ),
+        });
+    }
+    Ok(())
+}
+
+#[cfg(not(unix))]
+pub fn probe_stage(_path: &Path, _load: impl FnOnce() -> bool) -> Result<(), LoadError> {
+    Ok(())
+}

@@ -1,0 +1,196 @@
+//! USD asset paths through the file-access policy: an `ar::Resolver` that anchors and
+//! resolves as openusd's default one does (layer-relative identifiers, `.usdz` packages),
+//! but opens only regular files inside the scene's roots, refuses text layers nested
+//! deeper than the parser can take, and remembers every refusal so the load can fail
+//! with it rather than silently drop a layer.
+
+use std::io;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+
+use openusd::ar::{self, Asset, ResolvedPath, Resolver};
+
+use crate::limits::memory_budget;
+use crate::load::access::{AccessError, AssetRoots, read_regular_file};
+
+/// Deepest nesting of `{`, `[` and `(` accepted in a `.usda` layer. openusd's text parser
+/// recurses once per level; real files stay below a few dozen, and 10,000 levels overflow
+/// the stack (found by hostile testing).
+pub const MAX_TEXT_NESTING: usize = 500;
+
+/// Refusals met while the stage was composed, as messages.
+pub type Refusals = Arc<Mutex<Vec<String>>>;
+
+/// openusd's resolver behind the policy.
+pub struct ConfinedResolver {
+    inner: ar::DefaultResolver,
+    roots: AssetRoots,
+    refused: Refusals,
+}
+
+impl ConfinedResolver {
+    /// A resolver reading only inside `roots`; refusals are added to `refused`.
+    pub fn new(roots: AssetRoots, refused: Refusals) -> ConfinedResolver {
+        ConfinedResolver {
+            inner: ar::DefaultResolver::new(),
+            roots,
+            refused,
+        }
+    }
+
+    /// The file a resolved path lives in (a package's own file for `pkg.usdz[inner]`), if
+    /// the policy allows it.
+    fn check(&self, path: &str) -> Result<(), AccessError> {
+        let file = package_file(path);
+        self.roots.resolve(Path::new("/"), file).map(drop)
+    }
+
+    fn refuse(&self, why: String) {
+        if let Ok(mut refused) = self.refused.lock()
+            && !refused.contains(&why)
+        {
+            refused.push(why);
+        }
+    }
+}
+
+impl Resolver for ConfinedResolver {
+    fn create_identifier(&self, asset_path: &str, anchor: Option<&ResolvedPath>) -> String {
+        self.inner.create_identifier(asset_path, anchor)
+    }
+
+    fn resolve(&self, asset_path: &str) -> Option<ResolvedPath> {
+        if asset_path.is_empty() {
+            return None;
+        }
+        // Relative identifiers (no anchor) would be searched for in the working folder.
+        if !Path::new(package_file(asset_path)).is_absolute() {
+            self.refuse(format!(
+                "'{asset_path}' is not anchored to a layer; refused"
+            ));
+            return None;
+        }
+        match self.check(asset_path) {
+            Ok(()) => self.inner.resolve(asset_path),
+            // A missing file is the composition's business (an unresolved layer).
+            Err(AccessError::Io { source, .. }) if source.kind() == io::ErrorKind::NotFound => {
+                None
+            }
+            Err(why) => {
+                self.refuse(why.to_string());
+                None
+            }
+        }
+    }
+
+    fn resolve_for_new_asset(&self, _asset_path: &str) -> Option<ResolvedPath> {
+        None
+    }
+
+    fn open_asset(&self, resolved: &ResolvedPath) -> io::Result<Box<dyn Asset>> {
+        let name = resolved.to_string_lossy();
+        if let Err(why) = self.check(&name) {
+            self.refuse(why.to_string());
+            return Err(io::Error::other(why.to_string()));
+        }
+        if package_file(&name) != name {
+            return self.inner.open_asset(resolved);
+        }
+        let bytes = read_regular_file(resolved, &name, memory_budget())
+            .map_err(|e| io::Error::other(e.to_string()))?;
+        if !bytes.starts_with(b"PXR-USDC") && !bytes.starts_with(b"PK") {
+            let depth = nesting_depth(&bytes);
+            if depth > MAX_TEXT_NESTING {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!("{name}: nested {depth} levels deep, more than the {MAX_TEXT_NESTING} gridtrace reads"),
+                ));
+            }
+        }
+        Ok(Box::new(io::Cursor::new(bytes)))
+    }
+
+    fn identity(&self) -> String {
+        let roots: Vec<String> = self
+            .roots
+            .roots()
+            .iter()
+            .map(|r| format!("{r:?}"))
+            .collect();
+        format!("gridtrace-confined{}", roots.concat())
+    }
+}
+
+/// The outer file of a package-relative path (`/a/b.usdz[c/d.usdc]` → `/a/b.usdz`), or the
+/// path itself.
+fn package_file(path: &str) -> &str {
+    match (path.find('['), path.ends_with(']')) {
+        (Some(open), true) => &path[..open],
+        _ => path,
+    }
+}
+
+/// Deepest nesting of brackets in USD text, outside strings and comments.
+pub fn nesting_depth(text: &[u8]) -> usize {
+    let (mut depth, mut deepest) = (0usize, 0usize);
+    let mut i = 0;
+    while i < text.len() {
+        match text[i] {
+            b'{' | b'[' | b'(' => {
+                depth += 1;
+                deepest = deepest.max(depth);
+            }
+            b'}' | b']' | b')' => depth = depth.saturating_sub(1),
+            b'#' => {
+                while i < text.len() && text[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            quote @ (b'"' | b'\'') => {
+                // Triple-quoted strings run to the next triple quote.
+                let triple = text[i..].starts_with(&[quote; 3]);
+                i += if triple { 3 } else { 1 };
+                while i < text.len() {
+                    if text[i] == b'\\' {
+                        i += 2;
+                        continue;
+                    }
+                    if triple && text[i..].starts_with(&[quote; 3]) {
+                        i += 2;
+                        break;
+                    }
+                    if !triple && (text[i] == quote || text[i] == b'\n') {
+                        break;
+                    }
+                    i += 1;
+                }
+            }
+            b'@' => {
+                // Asset paths may hold brackets (`pkg.usdz[inner]`).
+                let end = text[i + 1..].iter().position(|&c| c == b'@' || c == b'\n');
+                i += end.map_or(text.len(), |e| e + 1);
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    deepest
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nesting_ignores_strings_comments_and_asset_paths() {
+        assert_eq!(nesting_depth(b"def X { a = [(1, 2)] }"), 3);
+        assert_eq!(nesting_depth(b"# {{{{\n\"{[(\" '[[' \"\"\"{\n{\"\"\" @a.usdz[b]@ {}"), 1);
+        assert_eq!(nesting_depth("{".repeat(10_000).as_bytes()), 10_000);
+    }
+
+    #[test]
+    fn package_paths_name_their_archive() {
+        assert_eq!(package_file("/a/b.usdz[c/d.usdc]"), "/a/b.usdz");
+        assert_eq!(package_file("/a/b.usda"), "/a/b.usda");
+    }
+}
