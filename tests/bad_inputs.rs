@@ -42,7 +42,7 @@ const CASES: &[(&str, Expect)] = &[
     ),
     (
         "missing_buffer.gltf",
-        Expect::Error("loading buffers: No such file"),
+        Expect::Error("buffer 0: 'missing.bin' not found"),
     ),
     ("missing_image.gltf", Expect::Warning("image 0 not found")),
     (

@@ -52,7 +52,15 @@ pub enum AccessError {
         /// What it is.
         kind: &'static str,
     },
-    /// The operating system's reason (missing, no permission).
+    /// No such file.
+    #[error("'{reference}' not found ({})", looked.display())]
+    Missing {
+        /// The path as the scene wrote it.
+        reference: String,
+        /// Where it was looked for.
+        looked: PathBuf,
+    },
+    /// The operating system's reason (no permission, ...).
     #[error("'{reference}': {source}")]
     Io {
         /// The path as the scene wrote it.
@@ -118,9 +126,18 @@ impl AssetRoots {
         if !self.contains(&lexical) {
             return Err(self.outside(reference));
         }
-        let canonical = joined.canonicalize().map_err(|source| AccessError::Io {
-            reference: reference.to_string(),
-            source,
+        let canonical = joined.canonicalize().map_err(|source| {
+            if source.kind() == std::io::ErrorKind::NotFound {
+                AccessError::Missing {
+                    reference: reference.to_string(),
+                    looked: lexical.clone(),
+                }
+            } else {
+                AccessError::Io {
+                    reference: reference.to_string(),
+                    source,
+                }
+            }
         })?;
         // Inside by name, outside through a symbolic link.
         if !self.contains(&canonical) {
@@ -220,11 +237,16 @@ fn special_kind(_file_type: &std::fs::FileType) -> &'static str {
 /// the colon is a Windows drive, not a scheme, and stays a (relative, missing) path.
 fn file_path(reference: &str) -> Option<PathBuf> {
     if let Some(rest) = strip_prefix_ignore_case(reference, "file:") {
-        let rest = rest
-            .strip_prefix("//localhost")
-            .or_else(|| rest.strip_prefix("//").filter(|r| r.starts_with('/')))
-            .unwrap_or(rest);
-        return rest.starts_with('/').then(|| PathBuf::from(rest));
+        // An authority other than localhost names another machine.
+        let local = match rest.strip_prefix("//") {
+            Some(authority_and_path) => authority_and_path
+                .strip_prefix("localhost")
+                .or_else(|| authority_and_path.starts_with('/').then_some(authority_and_path)),
+            None => Some(rest),
+        };
+        return local
+            .filter(|p| p.starts_with('/'))
+            .map(PathBuf::from);
     }
     let scheme = reference.split_once(':').map(|(s, _)| s);
     let is_scheme = scheme.is_some_and(|s| {
@@ -283,7 +305,7 @@ mod tests {
         let (dir, roots) = scene_dir();
         let base = dir.path().join("scene");
         assert_eq!(roots.read(&base, "inside.bin", 100).unwrap(), b"inside");
-        assert_eq!(roots.read(&base, "./sub/../inside.bin", 3).unwrap(), b"ins");
+        assert_eq!(roots.read(&base, "./../scene/inside.bin", 3).unwrap(), b"ins");
         let uri = format!("file://{}", base.join("inside.bin").display());
         assert_eq!(roots.read(&base, &uri, 100).unwrap(), b"inside");
     }

@@ -5,6 +5,7 @@ mod error;
 pub mod gltf;
 mod images;
 pub mod ply;
+mod polygon;
 mod tangents;
 pub mod usd;
 
@@ -14,7 +15,7 @@ pub use error::LoadError;
 use std::path::{Path, PathBuf};
 
 use crate::accel::Triangle;
-use crate::scene::Scene;
+use crate::scene::{MaterialKind, Scene};
 
 /// A loaded scene and the warnings met on the way (things skipped or approximated).
 #[derive(Debug)]
@@ -60,10 +61,45 @@ pub fn load_scene(path: &Path) -> Result<Loaded, LoadError> {
     load_scene_with(path, &LoadOptions::default())
 }
 
-/// Loads a scene, choosing the loader by file extension, and warns about triangles that
-/// will never be hit (no area, or non-finite corners).
+/// Loads a scene, choosing the loader by file extension; refuses materials no physics
+/// allows (an index of refraction that is not a positive number), and warns about
+/// triangles that will never be hit (no area, or non-finite corners) and instances whose
+/// transform flattens them to nothing (a zero scale).
 pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError> {
     let mut loaded = load_by_format(path, options)?;
+    for material in &loaded.scene.materials {
+        if let MaterialKind::Glass { ior, .. } = material.kind
+            && !(ior.is_finite() && ior > 0.0)
+        {
+            return Err(LoadError::Invalid {
+                path: path.to_path_buf(),
+                what: format!(
+                    "material '{}': index of refraction {ior} is not a positive number",
+                    material.name
+                ),
+            });
+        }
+    }
+    for instance in &loaded.scene.instances {
+        let m = instance.world_from_object;
+        let finite = m.matrix3.is_finite() && m.translation.is_finite();
+        // A zero scale along one axis may leave a visible flat mesh; along more, nothing.
+        let flattened = finite
+            && m.matrix3.determinant() == 0.0
+            && loaded.scene.meshes.get(instance.mesh).is_some_and(|mesh| {
+                mesh.indices.iter().all(|t| {
+                    let [a, b, c] = t.map(|i| m.transform_point3(mesh.positions[i as usize]));
+                    Triangle::new(a, b, c).is_degenerate()
+                })
+            });
+        if !finite || flattened {
+            loaded.warnings.push(format!(
+                "{}: {}: its transform is not finite or scales it to nothing; it can never be hit",
+                path.display(),
+                instance.source
+            ));
+        }
+    }
     for mesh in &loaded.scene.meshes {
         let (mut non_finite, mut zero_area) = (0usize, 0usize);
         for &[a, b, c] in &mesh.indices {

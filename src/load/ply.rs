@@ -11,6 +11,7 @@ use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{Property, PropertyAccess};
 
 use super::{LoadError, Loaded};
+use crate::limits::check_memory;
 use crate::scene::{Material, Mesh, SceneBuilder};
 
 /// Albedo of the material given to PLY meshes.
@@ -139,6 +140,15 @@ pub fn parse_mesh(
         .read_header(&mut reader)
         .map_err(|e| invalid(format!("bad PLY header: {e}")))?;
     check_declared_sizes(&header, budget).map_err(invalid)?;
+    check_memory(
+        || "the mesh its header declares".into(),
+        header
+            .elements
+            .values()
+            .map(|e| bytes_in_memory(&e.name, e.count as u64))
+            .fold(0, u64::saturating_add),
+    )
+    .map_err(|e| invalid(e.to_string()))?;
     let mut positions = Vec::new();
     let mut faces = Vec::new();
     for element in header.elements.values() {
@@ -177,6 +187,17 @@ pub fn parse_mesh(
         }
     }
     Ok((positions, triangles))
+}
+
+/// Memory `count` parsed elements named `name` take at least: a vertex its position, any
+/// other element (read as a polygon) its list of at least three 64-bit corners, and the
+/// triangles it becomes.
+fn bytes_in_memory(name: &str, count: u64) -> u64 {
+    let per_element = match name {
+        "vertex" => std::mem::size_of::<PlyVertex>() + std::mem::size_of::<Vec3>(),
+        _ => std::mem::size_of::<PlyFace>() + 3 * 8 + std::mem::size_of::<[u32; 3]>(),
+    };
+    count.saturating_mul(per_element as u64)
 }
 
 /// Refuses headers whose elements cannot fit in `budget` bytes: each element needs at least

@@ -3,6 +3,8 @@
 
 use glam::Vec3;
 
+use crate::scene::Aabb;
+
 /// True when the triangle `v` overlaps the box with centre `center` and half-size `half`.
 ///
 /// Touching counts as overlapping; callers pad the box to stay conservative under rounding.
@@ -67,5 +69,66 @@ mod tests {
             Vec3::new(0.0, 10.0, 0.1),
         ];
         assert!(triangle_overlaps_box(big, unit.0, unit.1));
+    }
+}
+
+/// A convex polygon of at most 9 corners: a triangle clipped by up to three slabs.
+#[derive(Clone, Copy, Debug)]
+pub struct Polygon {
+    corners: [Vec3; 9],
+    len: usize,
+}
+
+impl Polygon {
+    /// The triangle as a polygon.
+    pub fn from_triangle([a, b, c]: [Vec3; 3]) -> Polygon {
+        let mut corners = [Vec3::ZERO; 9];
+        corners[..3].copy_from_slice(&[a, b, c]);
+        Polygon { corners, len: 3 }
+    }
+
+    /// The part of the polygon with `lo ≤ p[axis] ≤ hi` (Sutherland & Hodgman 1974, against
+    /// the slab's two planes). Each plane adds at most one corner.
+    pub fn clip(&self, axis: usize, lo: f32, hi: f32) -> Polygon {
+        self.clip_plane(|p| p[axis] - lo, axis, lo)
+            .clip_plane(|p| hi - p[axis], axis, hi)
+    }
+
+    /// Keeps the side where `inside(p) ≥ 0`; new corners lie on the plane `p[axis] = at`.
+    fn clip_plane(&self, inside: impl Fn(Vec3) -> f32, axis: usize, at: f32) -> Polygon {
+        let mut out = Polygon {
+            corners: [Vec3::ZERO; 9],
+            len: 0,
+        };
+        let corners = &self.corners[..self.len];
+        for (i, &p) in corners.iter().enumerate() {
+            let q = corners[(i + 1) % corners.len()];
+            let (dp, dq) = (inside(p), inside(q));
+            if dp >= 0.0 {
+                out.push(p);
+            }
+            if (dp >= 0.0) != (dq >= 0.0) {
+                let mut crossing = p + (q - p) * (dp / (dp - dq));
+                crossing[axis] = at;
+                out.push(crossing);
+            }
+        }
+        out
+    }
+
+    fn push(&mut self, p: Vec3) {
+        if self.len < self.corners.len() {
+            self.corners[self.len] = p;
+            self.len += 1;
+        }
+    }
+
+    /// The corners' bounding box, or `None` if nothing is left.
+    pub fn bounds(&self) -> Option<Aabb> {
+        let corners = &self.corners[..self.len];
+        (!corners.is_empty()).then(|| Aabb {
+            min: corners.iter().fold(Vec3::INFINITY, |m, &p| m.min(p)),
+            max: corners.iter().fold(Vec3::NEG_INFINITY, |m, &p| m.max(p)),
+        })
     }
 }

@@ -20,6 +20,7 @@ mod resolver;
 use resolver::{ConfinedResolver, Refusals};
 
 use super::images::decode_texture;
+use super::polygon::triangulate;
 use super::tangents::generate_tangents;
 use super::access::read_regular_file;
 use super::{AssetRoots, LoadError, LoadOptions, Loaded};
@@ -1275,74 +1276,9 @@ fn blackbody_tint(kelvin: f32) -> Vec3 {
     rgb(kelvin as f64) / rgb(6500.0)
 }
 
-/// Triangles (as corner positions in `polygon`) covering a planar polygon: a fan when it is
-/// convex, ear clipping (Eberly, "Triangulation by Ear Clipping", 2002) otherwise.
-fn triangulate(polygon: &[Vec3]) -> Vec<[usize; 3]> {
-    let n = polygon.len();
-    if n < 3 {
-        return Vec::new();
-    }
-    // Newell's normal: robust for any planar polygon.
-    let mut normal = Vec3::ZERO;
-    for i in 0..n {
-        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
-        normal += Vec3::new(
-            (a.y - b.y) * (a.z + b.z),
-            (a.z - b.z) * (a.x + b.x),
-            (a.x - b.x) * (a.y + b.y),
-        );
-    }
-    let convex_at = |a: Vec3, b: Vec3, c: Vec3| (b - a).cross(c - b).dot(normal) >= 0.0;
-    if n == 3 || (0..n).all(|i| convex_at(polygon[i], polygon[(i + 1) % n], polygon[(i + 2) % n])) {
-        return (1..n - 1).map(|i| [0, i, i + 1]).collect();
-    }
-    let mut remaining: Vec<usize> = (0..n).collect();
-    let mut triangles = Vec::with_capacity(n - 2);
-    let inside = |p: Vec3, a: Vec3, b: Vec3, c: Vec3| {
-        (b - a).cross(p - a).dot(normal) > 0.0
-            && (c - b).cross(p - b).dot(normal) > 0.0
-            && (a - c).cross(p - c).dot(normal) > 0.0
-    };
-    while remaining.len() > 3 {
-        let m = remaining.len();
-        let ear = (0..m).find(|&i| {
-            let (ia, ib, ic) = (
-                remaining[(i + m - 1) % m],
-                remaining[i],
-                remaining[(i + 1) % m],
-            );
-            let (a, b, c) = (polygon[ia], polygon[ib], polygon[ic]);
-            convex_at(a, b, c)
-                && !remaining
-                    .iter()
-                    .any(|&j| j != ia && j != ib && j != ic && inside(polygon[j], a, b, c))
-        });
-        // A degenerate or self-intersecting polygon has no ear: cut the first corner.
-        let i = ear.unwrap_or(0);
-        triangles.push([
-            remaining[(i + m - 1) % m],
-            remaining[i],
-            remaining[(i + 1) % m],
-        ]);
-        remaining.remove(i);
-    }
-    triangles.push([remaining[0], remaining[1], remaining[2]]);
-    triangles
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn area(polygon: &[Vec3], triangles: &[[usize; 3]]) -> f32 {
-        triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| polygon[i]);
-                0.5 * (b - a).cross(c - a).dot(Vec3::Z)
-            })
-            .sum()
-    }
 
     #[test]
     fn sphere_lights_are_wound_outwards() {
@@ -1364,30 +1300,5 @@ mod tests {
         assert!(candle.x > 1.0 && candle.z < 0.3 * candle.x, "{candle}");
         let sky = blackbody_tint(12000.0);
         assert!(sky.z > sky.x, "{sky}");
-    }
-
-    #[test]
-    fn convex_polygons_become_fans_and_concave_ones_ears() {
-        let square = [
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::new(1.0, 1.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-        ];
-        assert_eq!(triangulate(&square), vec![[0, 1, 2], [0, 2, 3]]);
-        // An L shape (area 3) whose fan from corner 0 would cover the notch.
-        let l = [
-            Vec3::new(1.0, 1.0, 0.0),
-            Vec3::new(2.0, 1.0, 0.0),
-            Vec3::new(2.0, 2.0, 0.0),
-            Vec3::new(0.0, 2.0, 0.0),
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(1.0, 0.0, 0.0),
-        ];
-        let tris = triangulate(&l);
-        assert_eq!(tris.len(), 4);
-        assert!((area(&l, &tris) - 3.0).abs() < 1e-6, "{tris:?}");
-        // Every triangle keeps the polygon's orientation (positive area).
-        assert!(tris.iter().all(|t| area(&l, &[*t]) > 0.0), "{tris:?}");
     }
 }

@@ -73,9 +73,7 @@ impl Resolver for ConfinedResolver {
         match self.check(asset_path) {
             Ok(()) => self.inner.resolve(asset_path),
             // A missing file is the composition's business (an unresolved layer).
-            Err(AccessError::Io { source, .. }) if source.kind() == io::ErrorKind::NotFound => {
-                None
-            }
+            Err(AccessError::Missing { .. }) => None,
             Err(why) => {
                 self.refuse(why.to_string());
                 None
