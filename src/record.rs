@@ -232,17 +232,42 @@ pub fn sha256_file(path: &Path) -> io::Result<String> {
     Ok(Hex(&hasher.finalize()).to_string())
 }
 
+/// A file a scene was read from besides the scene file itself.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Dependency {
+    /// Where it is.
+    pub path: std::path::PathBuf,
+    /// How many of its first bytes were read, if not all (a glTF buffer reads its
+    /// `byteLength`): only those are hashed, so a huge file behind a small buffer costs
+    /// nothing.
+    pub bytes_read: Option<u64>,
+}
+
+impl Dependency {
+    /// A file read whole.
+    pub fn whole(path: std::path::PathBuf) -> Dependency {
+        Dependency {
+            path,
+            bytes_read: None,
+        }
+    }
+}
+
 /// One SHA-256 for a set of files: of the lines `NAME<TAB>SHA256`, sorted, where NAME is
 /// the path relative to `base` (the scene's folder) when it lies inside, so the same files
-/// mounted elsewhere on another machine hash the same.
-pub fn sha256_files(base: &Path, files: &[std::path::PathBuf]) -> io::Result<String> {
+/// mounted elsewhere on another machine hash the same, and SHA256 is of the bytes read.
+pub fn sha256_files(base: &Path, files: &[Dependency]) -> io::Result<String> {
     let base = base.canonicalize()?;
     let mut lines = files
         .iter()
-        .map(|file| {
-            let file = file.canonicalize()?;
+        .map(|dependency| {
+            let file = dependency.path.canonicalize()?;
             let name = file.strip_prefix(&base).unwrap_or(&file);
-            Ok(format!("{}\t{}\n", name.display(), sha256_file(&file)?))
+            let mut hasher = Sha256::new();
+            let reader = io::Read::take(std::fs::File::open(&file)?, dependency.bytes_read.unwrap_or(u64::MAX));
+            io::copy(&mut { reader }, &mut hasher)?;
+            let hash = Hex(&hasher.finalize()).to_string();
+            Ok(format!("{}\t{hash}\n", name.display()))
         })
         .collect::<io::Result<Vec<String>>>()?;
     lines.sort();

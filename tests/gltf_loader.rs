@@ -564,7 +564,7 @@ fn the_files_beside_a_gltf_are_listed() {
     let names: Vec<_> = loaded
         .files
         .iter()
-        .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
+        .map(|f| f.path.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
     assert_eq!(names, ["quad.bin", "wood.png"]);
 }

@@ -661,7 +661,7 @@ fn references_and_instances_are_composed() {
     let files: Vec<_> = loaded
         .files
         .iter()
-        .map(|f| f.file_name().unwrap())
+        .map(|f| f.path.file_name().unwrap())
         .collect();
     assert_eq!(files, ["part.usda"], "{:?}", loaded.files);
     let scene = &loaded.scene;

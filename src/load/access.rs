@@ -189,6 +189,8 @@ pub fn read_regular_file(path: &Path, reference: &str, limit: u64) -> Result<Vec
     let metadata = file.metadata().map_err(io)?;
     check_regular(&metadata, reference)?;
     let size = metadata.len().min(limit);
+    crate::limits::check_memory(|| format!("'{reference}'"), size)
+        .map_err(|e| io(std::io::Error::other(e.to_string())))?;
     let mut bytes = Vec::new();
     bytes
         .try_reserve_exact(size as usize)

@@ -15,6 +15,7 @@ pub use error::LoadError;
 use std::path::{Path, PathBuf};
 
 use crate::accel::Triangle;
+use crate::record::Dependency;
 use crate::scene::{MaterialKind, Scene};
 
 /// A loaded scene and the warnings met on the way (things skipped or approximated).
@@ -26,7 +27,7 @@ pub struct Loaded {
     pub warnings: Vec<String>,
     /// Other files the scene was read from (glTF buffers and images, USD layers and
     /// textures), so a render's record can say exactly what it rendered.
-    pub files: Vec<PathBuf>,
+    pub files: Vec<Dependency>,
 }
 
 /// How to read what a file leaves to convention.

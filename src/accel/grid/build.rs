@@ -67,7 +67,9 @@ impl Grid {
             )
         } else {
             let bounds = padded(tight);
-            (bounds, resolution(bounds.extent(), live.len(), density))
+            let wanted = resolution(bounds.extent(), live.len(), density);
+            let live_triangles = live.iter().map(|&i| triangles[i as usize].unwrap());
+            (bounds, within_reference_budget(wanted, bounds, live_triangles))
         };
         let cell_size = bounds.extent() / resolution.as_vec3();
         let mut grid = Grid {
@@ -86,7 +88,13 @@ impl Grid {
             triangle_count: indices.len(),
             inserted: live.len(),
         };
-        grid.insert(&triangles, indices, &live);
+        // The estimate above keeps references far below 2^32; should it ever be wrong,
+        // halve the resolution rather than overflow the 32-bit offsets.
+        while !grid.insert(&triangles, indices, &live) {
+            grid.resolution = (grid.resolution / 2).max(UVec3::ONE);
+            grid.cell_size = grid.bounds.extent() / grid.resolution.as_vec3();
+            grid.inv_cell_size = grid.cell_size.recip();
+        }
         grid
     }
 
@@ -94,7 +102,13 @@ impl Grid {
     /// triangles, giving (cell, triangle) pairs in triangle order; a counting sort by cell
     /// (count → prefix sum → place) then lays them out. Within a cell, triangles keep mesh
     /// order whatever the thread count, so ties between equal hits resolve the same way.
-    fn insert(&mut self, triangles: &[Option<Triangle>], indices: &[[u32; 3]], live: &[u32]) {
+    /// False, with nothing changed, if there are more references than 32-bit offsets hold.
+    fn insert(
+        &mut self,
+        triangles: &[Option<Triangle>],
+        indices: &[[u32; 3]],
+        live: &[u32],
+    ) -> bool {
         let cells = self.cell_count();
         let chunks: Vec<Vec<(u32, u32)>> = live
             .par_chunks(4096)
@@ -108,6 +122,10 @@ impl Grid {
                 pairs
             })
             .collect();
+        let references: usize = chunks.iter().map(Vec::len).sum();
+        if references >= u32::MAX as usize && self.resolution != UVec3::ONE {
+            return false;
+        }
         let mut counts = vec![0u32; cells];
         for &(cell, _) in chunks.iter().flatten() {
             counts[cell as usize] += 1;
@@ -161,6 +179,7 @@ impl Grid {
         }
         self.cell_corners = cell_corners;
         self.cell_triangle_ids = cell_triangle_ids;
+        true
     }
 
     /// Calls `f` with the index of every cell the triangle overlaps.
@@ -237,6 +256,47 @@ fn padded(b: Aabb) -> Aabb {
         min: b.min - pad,
         max: b.max + pad,
     }
+}
+
+/// Most references (cell, triangle pairs) the build may make per triangle on average, and in
+/// all: long thin triangles across a fine grid (a fan of 100k slivers) would otherwise
+/// make hundreds each, and more than 2^32 would overflow the offsets.
+const REFERENCES_PER_TRIANGLE: f64 = 32.0;
+const MAX_REFERENCES: f64 = (1u64 << 31) as f64;
+
+/// `wanted`, made coarser until the estimated references fit the budget. A triangle of
+/// area A and perimeter P overlaps about √3·A/s² + 2·P/s + 1 cells of side s (the cells its
+/// surface and its edges pass through), and never more than its bounding box holds.
+fn within_reference_budget(
+    wanted: UVec3,
+    bounds: Aabb,
+    triangles: impl Iterator<Item = Triangle> + Clone,
+) -> UVec3 {
+    let count = triangles.clone().count() as f64;
+    let budget = (REFERENCES_PER_TRIANGLE * count + (1 << 20) as f64).min(MAX_REFERENCES);
+    let mut r = wanted;
+    for _ in 0..32 {
+        let cell = bounds.extent() / r.as_vec3();
+        let s = cell.min_element().max(f32::MIN_POSITIVE) as f64;
+        let estimate: f64 = triangles
+            .clone()
+            .map(|t| {
+                let [a, b, c] = t.vertices();
+                let area = 0.5 * (b - a).cross(c - a).length() as f64;
+                let perimeter = ((b - a).length() + (c - b).length() + (a - c).length()) as f64;
+                let reach = t.bounds().extent() / cell + 1.0;
+                let boxed = reach.x as f64 * reach.y as f64 * reach.z as f64;
+                (3f64.sqrt() * area / (s * s) + 2.0 * perimeter / s + 1.0).min(boxed)
+            })
+            .sum();
+        if estimate <= budget || r == UVec3::ONE {
+            break;
+        }
+        // References grow as 1/s (edges) to 1/s² (surfaces): shrink by the square root.
+        let shrink = (budget / estimate).sqrt().clamp(0.25, 0.9) as f32;
+        r = (r.as_vec3() * shrink).floor().max(Vec3::ONE).as_uvec3();
+    }
+    r
 }
 
 /// Cells per axis after Cleary & Wyvill (1988): R_a = d_a · ∛(λN / V), which makes cells

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use crate::limits::check_memory;
 use crate::load::LoadError;
 use crate::load::access::{AccessError, AssetRoots};
+use crate::record::Dependency;
 
 /// The files of one glTF scene: where relative URIs start, what may be read, and what was.
 pub(super) struct SceneFiles {
@@ -18,8 +19,8 @@ pub(super) struct SceneFiles {
     pub base: PathBuf,
     /// The folders it may read.
     pub roots: AssetRoots,
-    /// Canonical paths of the files resolved so far, for the render record.
-    pub read: Vec<PathBuf>,
+    /// The files resolved so far, for the render record.
+    pub read: Vec<Dependency>,
 }
 
 impl SceneFiles {
@@ -40,16 +41,19 @@ impl SceneFiles {
     pub fn resolve(&mut self, uri: &str) -> Result<PathBuf, AccessError> {
         let decoded = urlencoding::decode(uri).map_or_else(|_| uri.into(), |d| d.into_owned());
         let path = self.roots.resolve(&self.base, &decoded)?;
-        if !self.read.contains(&path) {
-            self.read.push(path.clone());
+        if !self.read.iter().any(|d| d.path == path) {
+            self.read.push(Dependency::whole(path.clone()));
         }
         Ok(path)
     }
 
-    /// At most `limit` bytes of the file `uri` names.
-    pub fn read(&mut self, uri: &str, limit: u64) -> Result<Vec<u8>, AccessError> {
+    /// At most `limit` bytes of the file `uri` names (the whole file for `None`).
+    pub fn read(&mut self, uri: &str, limit: Option<u64>) -> Result<Vec<u8>, AccessError> {
         let path = self.resolve(uri)?;
-        crate::load::access::read_regular_file(&path, uri, limit)
+        if let Some(dependency) = self.read.iter_mut().find(|d| d.path == path) {
+            dependency.bytes_read = limit;
+        }
+        crate::load::access::read_regular_file(&path, uri, limit.unwrap_or(u64::MAX))
     }
 }
 
@@ -86,7 +90,7 @@ pub(super) fn read_buffers(
             ),
             gltf::buffer::Source::Uri(uri) => (
                 files
-                    .read(uri, length as u64)
+                    .read(uri, Some(length as u64))
                     .map_err(|e| invalid(format!("buffer {index}: {e}")))?,
                 format!("'{uri}'"),
             ),
@@ -130,7 +134,7 @@ pub(super) fn image_bytes<'a>(
             decode_data_uri(uri).map(Cow::Owned)
         }
         gltf::image::Source::Uri { uri, .. } => files
-            .read(uri, crate::limits::memory_budget())
+            .read(uri, None)
             .map(Cow::Owned)
             .map_err(|e| e.to_string()),
     }

@@ -25,6 +25,7 @@ use super::tangents::generate_tangents;
 use super::access::read_regular_file;
 use super::{AssetRoots, LoadError, LoadOptions, Loaded};
 use crate::limits::memory_budget;
+use crate::record::Dependency;
 use crate::scene::{
     AlphaMode, Camera, ColorSpace, Light, LightKind, Material, MaterialKind, MaterialTextures,
     Mesh, Projection, SceneBuilder, TextureRef, Wrap,
@@ -64,7 +65,9 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError
     let roots = AssetRoots::for_scene(path, &options.asset_paths);
     let time = options.usd_frame;
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        probe::probe_stage(path, || read_stage(path, time, &roots).is_ok())?;
+        if probe::may_hold_binary_layers(path) {
+            probe::probe_stage(path, || read_stage(path, time, &roots).is_ok())?;
+        }
         read_stage(path, time, &roots)
     }))
     .unwrap_or_else(|panic| {
@@ -150,13 +153,14 @@ fn read_stage(path: &Path, time: Option<f64>, roots: &AssetRoots) -> Result<Load
     }
     // Layer identifiers are absolute; the stage's own file is not a dependency.
     let own = path.canonicalize().ok();
-    let mut files: Vec<PathBuf> = loader
+    let mut files: Vec<Dependency> = loader
         .stage
         .layer_identifiers()
         .into_iter()
         .map(PathBuf::from)
         .chain(loader.texture_paths)
         .filter(|file| file.is_file() && file.canonicalize().ok() != own)
+        .map(Dependency::whole)
         .collect();
     files.sort();
     files.dedup();

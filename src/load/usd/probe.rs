@@ -8,10 +8,32 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+use super::resolver::is_layer;
 use crate::load::LoadError;
 
 /// Longest the probe may take before it is given up on (and the stage read in-process).
 const PROBE_DEADLINE: Duration = Duration::from_secs(120);
+
+/// False only for a text layer that names no other layer (no `@….usd[acz]@` asset path):
+/// such a stage holds nothing the binary reader sees, and need not be read twice.
+pub fn may_hold_binary_layers(path: &Path) -> bool {
+    let text = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("usda"));
+    if !text {
+        return true;
+    }
+    let Ok(bytes) = std::fs::read(path) else {
+        return true;
+    };
+    // Asset paths lie between `@` signs; looking at every piece between two of them (not
+    // only the odd ones) stays safe when a string or comment holds a stray `@`.
+    let pieces: Vec<&[u8]> = bytes.split(|&b| b == b'@').collect();
+    pieces.len() > 2
+        && pieces[1..pieces.len() - 1]
+            .iter()
+            .any(|piece| is_layer(&String::from_utf8_lossy(piece)))
+}
 
 /// Runs `load` in a forked child; a child killed by a signal (an abort, a stack overflow,
 /// the memory limit) becomes an error naming `path`. Without a child to spare, or if the
@@ -28,6 +50,15 @@ pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadE
         unsafe {
             libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL)
         };
+        // The reader's own last words (an allocation failure's message and backtrace) are
+        // not the user's business: the parent reports the crash in one line.
+        // SAFETY: opens /dev/null and moves it onto this process's stderr descriptor.
+        unsafe {
+            let null = libc::open(c"/dev/null".as_ptr(), libc::O_WRONLY);
+            if null >= 0 {
+                libc::dup2(null, libc::STDERR_FILENO);
+            }
+        }
         let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(load));
         // SAFETY: ends the child at once, as fork's documentation asks.
         unsafe { libc::_exit(0) };

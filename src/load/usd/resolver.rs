@@ -74,10 +74,13 @@ impl Resolver for ConfinedResolver {
             Ok(()) => self.inner.resolve(asset_path),
             // A missing file is the composition's business (an unresolved layer).
             Err(AccessError::Missing { .. }) => None,
-            Err(why) => {
+            // A refused layer fails the load; a refused texture is the loader's to warn
+            // about, as it reads textures itself through the same policy.
+            Err(why) if is_layer(asset_path) => {
                 self.refuse(why.to_string());
                 None
             }
+            Err(_) => None,
         }
     }
 
@@ -117,6 +120,14 @@ impl Resolver for ConfinedResolver {
             .collect();
         format!("gridtrace-confined{}", roots.concat())
     }
+}
+
+/// True for paths that name a layer (or a package of layers) by their extension.
+pub fn is_layer(path: &str) -> bool {
+    let file = package_file(path).to_ascii_lowercase();
+    [".usd", ".usda", ".usdc", ".usdz"]
+        .iter()
+        .any(|e| file.ends_with(e))
 }
 
 /// The outer file of a package-relative path (`/a/b.usdz[c/d.usdc]` → `/a/b.usdz`), or the
