@@ -186,7 +186,9 @@ pub fn read_part(path: &Path) -> Result<Part, MergeError> {
         )));
     }
     let file_size = std::fs::metadata(path).map_or(0, |m| m.len());
-    if (pixels as u64).saturating_mul(PART_BYTES_PER_PIXEL) > file_size.saturating_mul(MAX_COMPRESSION_RATIO) {
+    if (pixels as u64).saturating_mul(PART_BYTES_PER_PIXEL)
+        > file_size.saturating_mul(MAX_COMPRESSION_RATIO)
+    {
         return Err(part(record).damaged(format!(
             "the header says {width}x{height} pixels, more than its {file_size} bytes can hold"
         )));

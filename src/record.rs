@@ -264,7 +264,10 @@ pub fn sha256_files(base: &Path, files: &[Dependency]) -> io::Result<String> {
             let file = dependency.path.canonicalize()?;
             let name = file.strip_prefix(&base).unwrap_or(&file);
             let mut hasher = Sha256::new();
-            let reader = io::Read::take(std::fs::File::open(&file)?, dependency.bytes_read.unwrap_or(u64::MAX));
+            let reader = io::Read::take(
+                std::fs::File::open(&file)?,
+                dependency.bytes_read.unwrap_or(u64::MAX),
+            );
             io::copy(&mut { reader }, &mut hasher)?;
             let hash = Hex(&hasher.finalize()).to_string();
             Ok(format!("{}\t{hash}\n", name.display()))
@@ -363,13 +366,26 @@ mod tests {
             std::fs::write(dir.join("scene.bin"), b"buffer").unwrap();
             std::fs::write(dir.join("textures/wood.png"), content).unwrap();
             let files = [dir.join("textures/wood.png"), dir.join("scene.bin")];
-            sha256_files(dir, &files).unwrap()
+            sha256_files(dir, &files.map(Dependency::whole)).unwrap()
         };
         let root = tempfile::tempdir().unwrap();
         let here = hash_in(&root.path().join("a"), b"wood");
         assert_eq!(here, hash_in(&root.path().join("b/elsewhere"), b"wood"));
         assert_ne!(here, hash_in(&root.path().join("c"), b"oak"));
-        assert!(sha256_files(root.path(), &[root.path().join("missing")]).is_err());
+        let missing = Dependency::whole(root.path().join("missing"));
+        assert!(sha256_files(root.path(), &[missing]).is_err());
+        // Only the bytes read count: what lies past a buffer's byteLength does not.
+        let dir = root.path().join("a");
+        let head = |bytes: &[u8]| {
+            std::fs::write(dir.join("scene.bin"), bytes).unwrap();
+            let buffer = Dependency {
+                path: dir.join("scene.bin"),
+                bytes_read: Some(6),
+            };
+            sha256_files(&dir, &[buffer]).unwrap()
+        };
+        assert_eq!(head(b"buffer and more"), head(b"buffer"));
+        assert_ne!(head(b"buffer"), head(b"BUFFER"));
     }
 
     #[test]

@@ -44,7 +44,10 @@ const CASES: &[(&str, Expect)] = &[
         "missing_buffer.gltf",
         Expect::Error("buffer 0: 'missing.bin' not found"),
     ),
-    ("missing_image.gltf", Expect::Warning("image 0 not found")),
+    (
+        "missing_image.gltf",
+        Expect::Warning("image 0: 'missing texture.png' not found"),
+    ),
     (
         "unknown_required_extension.gltf",
         Expect::Error("requires unsupported glTF extension(s): EXT_teleport"),

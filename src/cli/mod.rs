@@ -140,9 +140,13 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     }
 
     let camera = choose_camera(&scene, args.camera.as_deref(), args.width, args.height)?;
-    camera
-        .validate()
-        .map_err(|why| anyhow!("{}: camera {}: {why}", scene_path.display(), camera_label(&camera)))?;
+    camera.validate().map_err(|why| {
+        anyhow!(
+            "{}: camera {}: {why}",
+            scene_path.display(),
+            camera_label(&camera)
+        )
+    })?;
     let (width, height) = image_size(args.width, args.height, camera.aspect_ratio());
     if width as u64 * height as u64 > args.max_pixels {
         bail!(
@@ -151,7 +155,10 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
             args.max_pixels
         );
     }
-    check_memory(|| format!("a {width}x{height} film"), film_bytes(width, height))?;
+    check_memory(
+        || format!("a {width}x{height} film"),
+        film_bytes(width, height),
+    )?;
     if let (Some(w), Some(h), Some(aspect)) = (args.width, args.height, camera.aspect_ratio())
         && ((w as f32 / h as f32) / aspect - 1.0).abs() > 0.01
     {
@@ -219,8 +226,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         }
         let (image, stats) = image_so_far();
         let _writing = output_lock();
-        if let Err(e) = write_image_with_record(&output, &image, Some(&record_of(&image, &stats)))
-        {
+        if let Err(e) = write_image_with_record(&output, &image, Some(&record_of(&image, &stats))) {
             checkpoint_error = Some(e);
         }
         last_checkpoint = Instant::now();

@@ -41,7 +41,9 @@ pub fn set_phase(phase: Phase) {
 
 /// Held while writing an output file, so that no signal ends the process half-way through.
 pub fn output_lock() -> MutexGuard<'static, ()> {
-    OUTPUT.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    OUTPUT
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
 /// The exit code for a run that a signal stopped: 128 + its number (130 for SIGINT, 143 for

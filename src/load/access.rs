@@ -119,7 +119,9 @@ impl AssetRoots {
         let joined = if path.is_absolute() {
             path
         } else {
-            base.canonicalize().unwrap_or_else(|_| absolute(base)).join(path)
+            base.canonicalize()
+                .unwrap_or_else(|_| absolute(base))
+                .join(path)
         };
         // Lexically outside: refused without asking the file system anything.
         let lexical = normalize(&joined);
@@ -241,14 +243,16 @@ fn file_path(reference: &str) -> Option<PathBuf> {
     if let Some(rest) = strip_prefix_ignore_case(reference, "file:") {
         // An authority other than localhost names another machine.
         let local = match rest.strip_prefix("//") {
-            Some(authority_and_path) => authority_and_path
-                .strip_prefix("localhost")
-                .or_else(|| authority_and_path.starts_with('/').then_some(authority_and_path)),
+            Some(authority_and_path) => {
+                authority_and_path.strip_prefix("localhost").or_else(|| {
+                    authority_and_path
+                        .starts_with('/')
+                        .then_some(authority_and_path)
+                })
+            }
             None => Some(rest),
         };
-        return local
-            .filter(|p| p.starts_with('/'))
-            .map(PathBuf::from);
+        return local.filter(|p| p.starts_with('/')).map(PathBuf::from);
     }
     let scheme = reference.split_once(':').map(|(s, _)| s);
     let is_scheme = scheme.is_some_and(|s| {
@@ -307,7 +311,10 @@ mod tests {
         let (dir, roots) = scene_dir();
         let base = dir.path().join("scene");
         assert_eq!(roots.read(&base, "inside.bin", 100).unwrap(), b"inside");
-        assert_eq!(roots.read(&base, "./../scene/inside.bin", 3).unwrap(), b"ins");
+        assert_eq!(
+            roots.read(&base, "./../scene/inside.bin", 3).unwrap(),
+            b"ins"
+        );
         let uri = format!("file://{}", base.join("inside.bin").display());
         assert_eq!(roots.read(&base, &uri, 100).unwrap(), b"inside");
     }

@@ -111,6 +111,9 @@ mod tests {
         let tris = triangulate(&star);
         assert_eq!(tris.len(), n - 2);
         let got = area(&star, &tris);
-        assert!((got - expected).abs() < 1e-3 * expected, "{got} vs {expected}");
+        assert!(
+            (got - expected).abs() < 1e-3 * expected,
+            "{got} vs {expected}"
+        );
     }
 }

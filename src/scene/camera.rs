@@ -63,7 +63,10 @@ impl Camera {
             }
         }
         if !self.znear.is_finite() || self.znear < 0.0 {
-            return Err(format!("near clipping distance {} is not a finite, non-negative distance", self.znear));
+            return Err(format!(
+                "near clipping distance {} is not a finite, non-negative distance",
+                self.znear
+            ));
         }
         let m = self.world_from_camera;
         let determinant = m.matrix3.determinant();

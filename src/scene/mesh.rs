@@ -28,9 +28,10 @@ pub struct Mesh {
 }
 
 impl Mesh {
-    /// Bounds of the vertices used by triangles.
+    /// Bounds of the finite vertices (a NaN or infinite corner's triangles are never hit, and
+    /// must not throw the default camera to infinity).
     pub fn bounds(&self) -> Aabb {
-        Aabb::from_points(self.positions.iter().copied())
+        Aabb::from_points(self.positions.iter().copied().filter(|p| p.is_finite()))
     }
 
     /// Area-weighted vertex normals, for meshes that come without normals.

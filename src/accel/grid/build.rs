@@ -69,7 +69,10 @@ impl Grid {
             let bounds = padded(tight);
             let wanted = resolution(bounds.extent(), live.len(), density);
             let live_triangles = live.iter().map(|&i| triangles[i as usize].unwrap());
-            (bounds, within_reference_budget(wanted, bounds, live_triangles))
+            (
+                bounds,
+                within_reference_budget(wanted, bounds, live_triangles),
+            )
         };
         let cell_size = bounds.extent() / resolution.as_vec3();
         let mut grid = Grid {
@@ -217,7 +220,8 @@ impl Grid {
             let Some(slab_bounds) = in_slab.bounds() else {
                 continue;
             };
-            let rows = self.cell_of(slab_bounds.min - pad).y..=self.cell_of(slab_bounds.max + pad).y;
+            let rows =
+                self.cell_of(slab_bounds.min - pad).y..=self.cell_of(slab_bounds.max + pad).y;
             for y in rows {
                 let (y0, y1) = slab(1, y);
                 let Some(row_bounds) = in_slab.clip(1, y0, y1).bounds() else {

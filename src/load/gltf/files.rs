@@ -141,7 +141,8 @@ pub(super) fn image_bytes<'a>(
 }
 
 fn is_data_uri(uri: &str) -> bool {
-    uri.get(..5).is_some_and(|s| s.eq_ignore_ascii_case("data:"))
+    uri.get(..5)
+        .is_some_and(|s| s.eq_ignore_ascii_case("data:"))
 }
 
 /// The bytes of a base64 `data:` URI (RFC 2397); glTF allows no other encoding.

@@ -205,6 +205,17 @@ fn validate(document: &gltf::Document) -> Result<(), String> {
             }
         }
     }
+    // The gltf crate unwraps an image's uri, or its mimeType beside a bufferView (found by
+    // fuzzing); the specification requires them (glTF 2.0 §5.17).
+    for (i, image) in root.images.iter().enumerate() {
+        match (&image.uri, &image.buffer_view, &image.mime_type) {
+            (None, None, _) => return Err(format!("images[{i}]: neither uri nor bufferView")),
+            (_, Some(_), None) => {
+                return Err(format!("images[{i}]: a bufferView image needs a mimeType"));
+            }
+            _ => {}
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         errors.push(format!("{}: {error}", path()))
@@ -446,7 +457,9 @@ impl GltfLoader {
     fn warn_about_unreadable_images(&mut self, document: &gltf::Document) {
         for image in document.images() {
             if let gltf::image::Source::Uri { uri, .. } = image.source()
-                && !uri.get(..5).is_some_and(|s| s.eq_ignore_ascii_case("data:"))
+                && !uri
+                    .get(..5)
+                    .is_some_and(|s| s.eq_ignore_ascii_case("data:"))
                 && let Err(why) = self.files.resolve(uri)
             {
                 self.missing_images.insert(image.index());

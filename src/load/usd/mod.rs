@@ -19,10 +19,10 @@ mod resolver;
 
 use resolver::{ConfinedResolver, Refusals};
 
+use super::access::read_regular_file;
 use super::images::decode_texture;
 use super::polygon::triangulate;
 use super::tangents::generate_tangents;
-use super::access::read_regular_file;
 use super::{AssetRoots, LoadError, LoadOptions, Loaded};
 use crate::limits::memory_budget;
 use crate::record::Dependency;
@@ -943,12 +943,9 @@ impl UsdLoader {
             self.texture_paths.push(full.clone());
             read_regular_file(&full, file, memory_budget())
         });
-        let decoded = match bytes
-            .map_err(|e| e.to_string())
-            .and_then(|bytes| {
-                decode_texture(file.to_string(), &bytes).map_err(|e| format!("'{file}' {e}"))
-            })
-        {
+        let decoded = match bytes.map_err(|e| e.to_string()).and_then(|bytes| {
+            decode_texture(file.to_string(), &bytes).map_err(|e| format!("'{file}' {e}"))
+        }) {
             Ok(texture) => Some(self.builder.add_texture(texture)),
             Err(why) => {
                 self.warn(format!(

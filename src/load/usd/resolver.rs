@@ -104,7 +104,9 @@ impl Resolver for ConfinedResolver {
             if depth > MAX_TEXT_NESTING {
                 return Err(io::Error::new(
                     io::ErrorKind::InvalidData,
-                    format!("{name}: nested {depth} levels deep, more than the {MAX_TEXT_NESTING} gridtrace reads"),
+                    format!(
+                        "{name}: nested {depth} levels deep, more than the {MAX_TEXT_NESTING} gridtrace reads"
+                    ),
                 ));
             }
         }
@@ -193,7 +195,10 @@ mod tests {
     #[test]
     fn nesting_ignores_strings_comments_and_asset_paths() {
         assert_eq!(nesting_depth(b"def X { a = [(1, 2)] }"), 3);
-        assert_eq!(nesting_depth(b"# {{{{\n\"{[(\" '[[' \"\"\"{\n{\"\"\" @a.usdz[b]@ {}"), 1);
+        assert_eq!(
+            nesting_depth(b"# {{{{\n\"{[(\" '[[' \"\"\"{\n{\"\"\" @a.usdz[b]@ {}"),
+            1
+        );
         assert_eq!(nesting_depth("{".repeat(10_000).as_bytes()), 10_000);
     }
 

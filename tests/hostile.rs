@@ -1,0 +1,654 @@
+//! The hostile-input corpus (made at test time by `tools/make_hostile_inputs.py`, since it
+//! needs a FIFO, a symbolic link and a sparse 3 GB file): every case ends in a one-line
+//! error naming the file, or a warning naming it and an image, within a minute and within
+//! a 2 GiB address-space limit (`setrlimit` in the child, so an allocation past it fails
+//! as it would on a smaller machine). No message holds a byte of a file outside the scene's
+//! folder. Signals and checkpoints never lose the samples taken.
+
+mod binary;
+
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use gridtrace::merge::{MERGE_TOLERANCE, read_part};
+use gridtrace::output::read_exr_rgba;
+
+/// The address space every run gets.
+const MEMORY_LIMIT: u64 = 2 << 30;
+/// Longest any run may take.
+const TIME_LIMIT: Duration = Duration::from_secs(60);
+/// The secret outside the scenes' folder (tools/make_hostile_inputs.py writes it).
+const SECRET: &[u8] = b"TOPSECRET-canary-7f3a-gridtrace-hostile-input-corpus!!!!";
+
+enum Expect {
+    /// Exit code 2 and one line: `error: <file>: ...<text>...`.
+    Error(&'static str),
+    /// Exit code 0, an image, and a warning naming the file that contains the text.
+    Warning(&'static str),
+    /// Exit code 0 and an image.
+    Image,
+}
+
+const CASES: &[(&str, Expect)] = &[
+    // Reading outside the roots, or files that are not regular.
+    (
+        "leak_relative.gltf",
+        Expect::Error("buffer 1: '../secret.txt' is outside the folders"),
+    ),
+    (
+        "leak_absolute.gltf",
+        Expect::Error("is outside the folders this scene may read"),
+    ),
+    ("leak_file_uri.gltf", Expect::Error("buffer 1: 'file:///")),
+    (
+        "leak_percent.gltf",
+        Expect::Error("buffer 1: '../secret.txt' is outside"),
+    ),
+    (
+        "leak_proc.gltf",
+        Expect::Error("'/proc/self/environ' is outside"),
+    ),
+    ("leak_symlink.gltf", Expect::Error("'link.bin' is outside")),
+    (
+        "fifo_buffer.gltf",
+        Expect::Error("'pipe.bin' is a FIFO, not a regular file"),
+    ),
+    ("dev_stdin.gltf", Expect::Error("'/dev/stdin' is outside")),
+    ("dev_zero.gltf", Expect::Error("'/dev/zero' is outside")),
+    ("huge_buffer.gltf", Expect::Image),
+    (
+        "image_outside.gltf",
+        Expect::Warning("image 0: '../secret.txt' is outside"),
+    ),
+    (
+        "usd_sublayer_outside.usda",
+        Expect::Error("secret.usda' is outside"),
+    ),
+    (
+        "usd_reference_outside.usda",
+        Expect::Error("secret.usda' is outside"),
+    ),
+    (
+        "usd_reference_fifo.usda",
+        Expect::Error("pipe.usda' is a FIFO"),
+    ),
+    (
+        "usd_texture_outside.usda",
+        Expect::Warning("texture '../secret.txt' is outside"),
+    ),
+    // Aborts.
+    (
+        "usd_corrupt_reference.usda",
+        Expect::Error("the USD reader crashed"),
+    ),
+    (
+        "usd_corrupt_sublayer.usda",
+        Expect::Error("the USD reader crashed"),
+    ),
+    (
+        "usd_deep_prims.usda",
+        Expect::Error("nested 10000 levels deep"),
+    ),
+    (
+        "usd_deep_dictionary.usda",
+        Expect::Error("levels deep, more than the 500"),
+    ),
+    (
+        "many_faces.ply.gz",
+        Expect::Error("the mesh its header declares needs 7.2 GB"),
+    ),
+    // Time.
+    (
+        "ply_big_polygon.ply",
+        Expect::Warning("the scene has no emitters"),
+    ),
+    ("usd_big_polygon.usda", Expect::Image),
+    // Content dropped, impossible cameras and materials, overflowing counts.
+    (
+        "usd_missing_sublayer.usda",
+        Expect::Warning("unresolved sublayer @not_there.usda@"),
+    ),
+    (
+        "usd_broken_reference.usda",
+        Expect::Warning("malformed Reference layer"),
+    ),
+    (
+        "usd_negative_counts.usda",
+        Expect::Error("faceVertexCounts[0] is -3"),
+    ),
+    (
+        "camera_yfov_zero.gltf",
+        Expect::Error("vertical field of view 0 rad"),
+    ),
+    (
+        "camera_yfov_infinite.gltf",
+        Expect::Error("vertical field of view inf rad"),
+    ),
+    (
+        "camera_ortho_zero.gltf",
+        Expect::Error("orthographic view 0x0 has no size"),
+    ),
+    (
+        "camera_zero_matrix.gltf",
+        Expect::Error("transform is not finite or is degenerate"),
+    ),
+    (
+        "zero_scale.gltf",
+        Expect::Warning("node 0: its transform is not finite or scales it to nothing"),
+    ),
+    (
+        "ior_negative.gltf",
+        Expect::Error("index of refraction -1.5 is not a positive number"),
+    ),
+    (
+        "ior_infinite.gltf",
+        Expect::Error("index of refraction inf is not a positive number"),
+    ),
+    (
+        "count_overflow.gltf",
+        Expect::Error("accessor 0 needs 55340232221128654860 bytes"),
+    ),
+];
+
+/// The corpus, made once per test run under Cargo's temporary folder for tests.
+fn corpus() -> &'static Path {
+    static CORPUS: OnceLock<PathBuf> = OnceLock::new();
+    CORPUS.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("hostile-corpus");
+        let _ = std::fs::remove_dir_all(&dir);
+        let status = Command::new("python3")
+            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/make_hostile_inputs.py"))
+            .arg(&dir)
+            .status()
+            .expect("python3 runs tools/make_hostile_inputs.py");
+        assert!(status.success(), "tools/make_hostile_inputs.py failed");
+        dir
+    })
+}
+
+fn scenes() -> PathBuf {
+    corpus().join("scenes")
+}
+
+/// How a limited run ended.
+struct Run {
+    code: Option<i32>,
+    stderr: String,
+    /// Peak resident memory in bytes.
+    peak: u64,
+    elapsed: Duration,
+}
+
+/// Starts gridtrace with `args` in `cwd` under the memory limit, its stderr going to a
+/// file (read with [`stderr_of`]).
+fn spawn_limited(args: &[&str], cwd: &Path, stderr: &Path) -> std::process::Child {
+    let log = std::fs::File::create(stderr).unwrap();
+    let mut command = Command::new(env!("CARGO_BIN_EXE_gridtrace"));
+    command
+        .args(args)
+        .current_dir(cwd)
+        .stdout(Stdio::null())
+        .stderr(log);
+    // SAFETY: only setrlimit, which is async-signal-safe, runs between fork and exec.
+    unsafe {
+        command.pre_exec(|| {
+            let limit = libc::rlimit {
+                rlim_cur: MEMORY_LIMIT,
+                rlim_max: MEMORY_LIMIT,
+            };
+            if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    command.spawn().expect("start gridtrace")
+}
+
+/// Waits for `child` (killing it past the time limit) and reports its peak memory.
+fn wait_limited(child: std::process::Child, stderr: &Path, started: Instant) -> Run {
+    let pid = child.id() as libc::pid_t;
+    let mut status = 0;
+    // SAFETY: zeroed rusage is a valid value for wait4 to overwrite.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    loop {
+        // SAFETY: waits for our own child, with valid pointers.
+        let waited = unsafe { libc::wait4(pid, &mut status, libc::WNOHANG, &mut usage) };
+        if waited == pid {
+            break;
+        }
+        if started.elapsed() > TIME_LIMIT {
+            // SAFETY: kills and reaps our own child.
+            unsafe {
+                libc::kill(pid, libc::SIGKILL);
+                libc::wait4(pid, &mut status, 0, &mut usage);
+            }
+            panic!("hung: still running after {TIME_LIMIT:?}");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::mem::forget(child);
+    Run {
+        code: libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status)),
+        stderr: std::fs::read_to_string(stderr).unwrap_or_default(),
+        peak: usage.ru_maxrss as u64 * 1024,
+        elapsed: started.elapsed(),
+    }
+}
+
+fn run_limited(args: &[&str], cwd: &Path) -> Run {
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let logs = tempfile::tempdir().unwrap();
+    let log = logs.path().join(format!("stderr-{n}.txt"));
+    let started = Instant::now();
+    let child = spawn_limited(args, cwd, &log);
+    wait_limited(child, &log, started)
+}
+
+/// No byte of the secret in `text`: neither its words nor the integers an index accessor
+/// would make of them.
+fn assert_no_secret(name: &str, text: &str) {
+    assert!(
+        !text.contains("TOPSECRET") && !text.contains("canary"),
+        "{name}: {text}"
+    );
+    for word in SECRET.chunks_exact(4) {
+        let n = u32::from_le_bytes(word.try_into().unwrap());
+        assert!(!text.contains(&n.to_string()), "{name}: leaks {n}: {text}");
+    }
+}
+
+fn temporary_files(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".gridtrace-"))
+        .collect()
+}
+
+#[test]
+fn every_hostile_scene_ends_in_a_clear_outcome_within_time_and_memory() {
+    let scenes = scenes();
+    let out = tempfile::tempdir().unwrap();
+    let mut slowest = (Duration::ZERO, "");
+    let mut hungriest = (0, "");
+    for (name, expect) in CASES {
+        let image = out.path().join(format!("{name}.png"));
+        let args = [
+            name,
+            "-o",
+            image.to_str().unwrap(),
+            "--width",
+            "16",
+            "--spp",
+            "1",
+            "-q",
+        ];
+        let run = run_limited(&args, &scenes);
+        let err = &run.stderr;
+        assert!(!err.contains("panicked"), "{name}: {err}");
+        assert_no_secret(name, err);
+        match expect {
+            Expect::Error(text) => {
+                assert_eq!(run.code, Some(2), "{name}: {err}");
+                assert_eq!(err.lines().count(), 1, "{name}: one line expected:\n{err}");
+                assert!(
+                    err.starts_with("error: ") && err.contains(name) && err.contains(text),
+                    "{name}: expected '{text}':\n{err}"
+                );
+                assert!(!image.exists(), "{name}: an image was written");
+            }
+            Expect::Warning(text) => {
+                assert_eq!(run.code, Some(0), "{name}: {err}");
+                let warning = err.lines().find(|l| l.contains(text));
+                assert!(
+                    warning.is_some_and(|w| w.starts_with("warning: ") && w.contains(name)),
+                    "{name}: no warning with '{text}':\n{err}"
+                );
+                assert!(image::open(&image).is_ok(), "{name}: no readable image");
+            }
+            Expect::Image => {
+                assert_eq!(run.code, Some(0), "{name}: {err}");
+                assert!(image::open(&image).is_ok(), "{name}: no readable image");
+            }
+        }
+        if run.elapsed > slowest.0 {
+            slowest = (run.elapsed, name);
+        }
+        if run.peak > hungriest.0 {
+            hungriest = (run.peak, name);
+        }
+    }
+    assert!(hungriest.0 < MEMORY_LIMIT, "{hungriest:?}");
+    assert!(temporary_files(out.path()).is_empty());
+    println!(
+        "{} cases; slowest {} in {:.2} s; most memory {} with {:.0} MB",
+        CASES.len(),
+        slowest.1,
+        slowest.0.as_secs_f64(),
+        hungriest.1,
+        hungriest.0 as f64 / 1e6
+    );
+}
+
+#[test]
+fn an_asset_path_lets_a_scene_read_another_folder() {
+    let scenes = scenes();
+    let out = tempfile::tempdir().unwrap();
+    let image = out.path().join("ok.png");
+    let outside = corpus().to_str().unwrap().to_string();
+    let args = [
+        "usd_reference_outside.usda",
+        "-o",
+        image.to_str().unwrap(),
+        "--width",
+        "8",
+        "--spp",
+        "1",
+        "-q",
+        "--asset-path",
+        &outside,
+    ];
+    let run = run_limited(&args, &scenes);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+}
+
+#[test]
+fn films_and_parts_larger_than_memory_are_refused_before_allocation() {
+    let scenes = scenes();
+    let out = tempfile::tempdir().unwrap();
+    let image = out.path().join("big.exr");
+    let image = image.to_str().unwrap();
+    let run = run_limited(
+        &[
+            "huge_buffer.gltf",
+            "-o",
+            image,
+            "--width",
+            "16384",
+            "--height",
+            "16384",
+            "-q",
+        ],
+        &scenes,
+    );
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr.starts_with("error: a 16384x16384 film needs")
+            && run.stderr.lines().count() == 1,
+        "{}",
+        run.stderr
+    );
+    // A part whose header claims 16384² pixels in a few kilobytes.
+    let part = out.path().join("part.exr");
+    let small = [
+        "huge_buffer.gltf",
+        "-o",
+        part.to_str().unwrap(),
+        "--width",
+        "4",
+        "--samples",
+        "0..1",
+        "-q",
+    ];
+    assert_eq!(run_limited(&small, &scenes).code, Some(0));
+    let claiming = out.path().join("claims-16384.exr");
+    let status = Command::new("python3")
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/make_hostile_inputs.py"))
+        .args([
+            "--exr-claiming",
+            part.to_str().unwrap(),
+            "16384",
+            claiming.to_str().unwrap(),
+        ])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let size = std::fs::metadata(&claiming).unwrap().len();
+    assert!(size < 16 << 10, "{size} bytes");
+    let merged = out.path().join("merged.exr");
+    let run = run_limited(
+        &[
+            "merge",
+            claiming.to_str().unwrap(),
+            "-o",
+            merged.to_str().unwrap(),
+        ],
+        out.path(),
+    );
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("claims-16384.exr")
+            && run.stderr.contains("16384x16384 pixels, more than its")
+            && run.stderr.lines().count() == 1,
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn the_output_is_checked_before_anything_is_loaded() {
+    let out = tempfile::tempdir().unwrap();
+    let folder = out.path().join("render.exr");
+    std::fs::create_dir(&folder).unwrap();
+    // The scene does not exist: the error must be the output's, found first.
+    let run = run_limited(
+        &["missing.gltf", "-o", folder.to_str().unwrap()],
+        out.path(),
+    );
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("render.exr: is a directory"),
+        "{}",
+        run.stderr
+    );
+
+    let locked = out.path().join("locked.png");
+    std::fs::write(&locked, b"an earlier render").unwrap();
+    let immutable = Command::new("chattr").arg("+i").arg(&locked).status();
+    if !immutable.is_ok_and(|s| s.success()) {
+        println!("skipping the immutable-file case: chattr +i is not available here");
+        return;
+    }
+    let run = run_limited(
+        &["missing.gltf", "-o", locked.to_str().unwrap()],
+        out.path(),
+    );
+    let _ = Command::new("chattr").arg("-i").arg(&locked).status();
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("locked.png: cannot replace the existing file"),
+        "{}",
+        run.stderr
+    );
+}
+
+fn cornell_box() -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell_box.glb");
+    path.to_str().unwrap().to_string()
+}
+
+/// Starts a long render of the Cornell box and waits until it is rendering.
+fn start_long_render(out: &Path, extra: &[&str]) -> (std::process::Child, PathBuf, Instant) {
+    let image = out.join("partial.exr");
+    let log = out.join("stderr.txt");
+    let scene = cornell_box();
+    let mut args = vec![
+        scene.as_str(),
+        "-o",
+        image.to_str().unwrap(),
+        "--width",
+        "32",
+        "--spp",
+        "10000000",
+    ];
+    args.extend_from_slice(extra);
+    let started = Instant::now();
+    let child = spawn_limited(&args, &scenes(), &log);
+    while !std::fs::read_to_string(&log)
+        .unwrap_or_default()
+        .contains("prepared in")
+    {
+        assert!(started.elapsed() < TIME_LIMIT, "the render never started");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    (child, image, started)
+}
+
+fn samples_in(image: &Path) -> std::ops::Range<u32> {
+    read_part(image).expect("a valid part").record.samples
+}
+
+#[test]
+fn sigterm_and_sighup_write_the_partial_image_like_ctrl_c() {
+    for (signal, code) in [
+        (libc::SIGTERM, 143),
+        (libc::SIGHUP, 129),
+        (libc::SIGINT, 130),
+    ] {
+        let out = tempfile::tempdir().unwrap();
+        let (child, image, started) = start_long_render(out.path(), &[]);
+        std::thread::sleep(Duration::from_millis(300));
+        // SAFETY: signals our own child.
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+        let run = wait_limited(child, &out.path().join("stderr.txt"), started);
+        assert_eq!(run.code, Some(code), "signal {signal}: {}", run.stderr);
+        let samples = samples_in(&image);
+        assert!(samples.start == 0 && samples.end > 0, "{samples:?}");
+        assert!(
+            run.stderr.contains("writing the image so far"),
+            "{}",
+            run.stderr
+        );
+        assert!(temporary_files(out.path()).is_empty());
+    }
+}
+
+#[test]
+fn a_second_signal_quits_at_once_and_never_half_way_through_a_write() {
+    for delay_ms in [0, 1, 3, 10, 30] {
+        let out = tempfile::tempdir().unwrap();
+        // Checkpoints every 10 ms: a write is under way much of the time.
+        let (child, image, started) = start_long_render(out.path(), &["--checkpoint", "0.01"]);
+        std::thread::sleep(Duration::from_millis(200));
+        let pid = child.id() as libc::pid_t;
+        // SAFETY: signals our own child.
+        unsafe { libc::kill(pid, libc::SIGINT) };
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        // SAFETY: as above.
+        unsafe { libc::kill(pid, libc::SIGINT) };
+        let run = wait_limited(child, &out.path().join("stderr.txt"), started);
+        assert_eq!(run.code, Some(130), "{}", run.stderr);
+        assert!(
+            temporary_files(out.path()).is_empty(),
+            "delay {delay_ms} ms"
+        );
+        // Whatever was written is a whole part (a checkpoint or the final image).
+        if image.exists() {
+            assert!(samples_in(&image).end > 0);
+        }
+    }
+}
+
+#[test]
+fn a_signal_while_loading_quits_at_once() {
+    let out = tempfile::tempdir().unwrap();
+    let image = out.path().join("never.png");
+    let log = out.path().join("stderr.txt");
+    let started = Instant::now();
+    // Reading this 7 MB USD layer takes seconds.
+    let child = spawn_limited(
+        &["usd_big_polygon.usda", "-o", image.to_str().unwrap()],
+        &scenes(),
+        &log,
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    // SAFETY: signals our own child.
+    unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) };
+    let signalled = Instant::now();
+    let run = wait_limited(child, &log, started);
+    assert_eq!(run.code, Some(130), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("quitting before rendering"),
+        "{}",
+        run.stderr
+    );
+    assert!(
+        signalled.elapsed() < Duration::from_secs(1),
+        "{:?}",
+        signalled.elapsed()
+    );
+    assert!(!image.exists());
+}
+
+#[test]
+fn a_killed_checkpointed_render_resumes_into_the_uninterrupted_image() {
+    let out = tempfile::tempdir().unwrap();
+    let (child, checkpoint, started) = start_long_render(out.path(), &["--checkpoint", "0.05"]);
+    std::thread::sleep(Duration::from_millis(800));
+    // SAFETY: kills our own child, giving it no chance to write anything more.
+    unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGKILL) };
+    let run = wait_limited(child, &out.path().join("stderr.txt"), started);
+    assert_eq!(run.code, None, "killed");
+    let done = samples_in(&checkpoint);
+    assert!(done.start == 0 && done.end > 0, "{done:?}");
+    let end = done.end + 7;
+    let dir = scenes();
+    let path = |name: &str| out.path().join(name).to_str().unwrap().to_string();
+    let render = |args: &[&str]| {
+        let output = binary::gridtrace(args, &dir);
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    };
+    let rest = format!("{}..{end}", done.end);
+    let scene = cornell_box();
+    render(&[
+        &scene,
+        "-o",
+        &path("rest.exr"),
+        "--width",
+        "32",
+        "--samples",
+        &rest,
+        "-q",
+    ]);
+    render(&[
+        "merge",
+        &path("partial.exr"),
+        &path("rest.exr"),
+        "-o",
+        &path("merged.exr"),
+        "--samples",
+        &format!("0..{end}"),
+        "-q",
+    ]);
+    render(&[
+        &scene,
+        "-o",
+        &path("whole.exr"),
+        "--width",
+        "32",
+        "--spp",
+        &end.to_string(),
+        "-q",
+    ]);
+    let (merged, merged_alpha) = read_exr_rgba(Path::new(&path("merged.exr"))).unwrap();
+    let (whole, whole_alpha) = read_exr_rgba(Path::new(&path("whole.exr"))).unwrap();
+    assert_eq!(merged_alpha, whole_alpha);
+    for (i, (m, w)) in merged.iter().zip(&whole).enumerate() {
+        let scale = m.abs().max(w.abs()).max_element();
+        assert!(
+            (*m - *w).abs().max_element() <= MERGE_TOLERANCE * scale,
+            "pixel {i}: {m} vs {w} (checkpoint held samples {done:?})"
+        );
+    }
+}
