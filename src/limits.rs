@@ -79,7 +79,7 @@ fn machine_memory() -> u64 {
         // SAFETY: a valid resource and a valid pointer to write the limits to.
         let ok = unsafe { libc::getrlimit(resource, &mut rlimit) } == 0;
         if ok && rlimit.rlim_cur != libc::RLIM_INFINITY {
-            rlimit.rlim_cur as u64
+            rlimit.rlim_cur
         } else {
             u64::MAX
         }

@@ -79,6 +79,9 @@ pub struct RenderStats {
     pub spp: u32,
 }
 
+/// Makes the image of the samples taken so far, for a checkpoint.
+pub type ImageSoFar<'a> = &'a dyn Fn() -> (Image, RenderStats);
+
 /// A scene prepared for rendering.
 pub struct Renderer<'a> {
     scene: &'a Scene,
@@ -148,7 +151,7 @@ impl<'a> Renderer<'a> {
         settings: &RenderSettings,
         on_row: &(dyn Fn() + Sync),
         stop: &AtomicBool,
-        on_pass: &mut dyn FnMut(&dyn Fn() -> (Image, RenderStats)),
+        on_pass: &mut dyn FnMut(ImageSoFar),
     ) -> (Image, RenderStats) {
         let start = Instant::now();
         let generator = RayGenerator::new(camera, settings.width, settings.height);
