@@ -2,9 +2,9 @@
 //! from a file or an option (a film, a merged part, a decompressed mesh), so a hostile or
 //! mistaken input gets a clear error instead of an abort when the allocation fails.
 //!
-//! The budget is the smallest of the machine's physical memory and the process's
-//! address-space and data-segment limits (`ulimit -v`, `ulimit -d`, `prlimit`), or what
-//! `--max-memory` says.
+//! The budget is the smallest of 80 % of the machine's physical memory (the rest is the
+//! system's and the scene's) and the process's address-space and data-segment limits
+//! (`ulimit -v`, `ulimit -d`, `prlimit`), or what `--max-memory` says.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -58,7 +58,7 @@ pub fn bytes_of<T>(count: u64) -> u64 {
     count.saturating_mul(std::mem::size_of::<T>() as u64)
 }
 
-/// Physical memory, capped by the process's address-space and data limits.
+/// 80 % of physical memory, capped by the process's address-space and data limits.
 #[cfg(unix)]
 fn machine_memory() -> u64 {
     // SAFETY: sysconf and getrlimit only write to the struct passed by pointer.
@@ -66,7 +66,7 @@ fn machine_memory() -> u64 {
         let pages = libc::sysconf(libc::_SC_PHYS_PAGES);
         let size = libc::sysconf(libc::_SC_PAGESIZE);
         if pages > 0 && size > 0 {
-            (pages as u64).saturating_mul(size as u64)
+            (pages as u64).saturating_mul(size as u64) / 5 * 4
         } else {
             u64::MAX
         }

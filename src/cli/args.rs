@@ -109,8 +109,8 @@ pub struct Args {
     pub asset_path: Vec<PathBuf>,
 
     /// Most memory to use (bytes, or with K, M, G, T: "16G"); larger films, parts and
-    /// meshes are refused before they are allocated. [default: the machine's memory, or
-    /// the process's limit (ulimit -v) if lower]
+    /// meshes are refused before they are allocated. [default: 80 % of the machine's
+    /// memory, or the process's limit (ulimit -v) if lower]
     #[arg(long, value_name = "SIZE", value_parser = parse_size)]
     pub max_memory: Option<u64>,
 

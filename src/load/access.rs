@@ -265,8 +265,11 @@ fn file_path(reference: &str) -> Option<PathBuf> {
 }
 
 fn strip_prefix_ignore_case<'a>(text: &'a str, prefix: &str) -> Option<&'a str> {
-    (text.len() >= prefix.len() && text[..prefix.len()].eq_ignore_ascii_case(prefix))
-        .then(|| &text[prefix.len()..])
+    // `get`: the text may hold a multi-byte character where the prefix would end (found by
+    // fuzzing).
+    text.get(..prefix.len())
+        .filter(|head| head.eq_ignore_ascii_case(prefix))
+        .map(|_| &text[prefix.len()..])
 }
 
 /// `path` made absolute against the working folder.
@@ -382,5 +385,9 @@ mod tests {
         assert_eq!(file_path("file://server/x"), None);
         assert_eq!(file_path("http://x"), None);
         assert_eq!(file_path("data:abc"), None);
+        assert_eq!(
+            file_path("data\u{2de}x"),
+            Some(PathBuf::from("data\u{2de}x"))
+        );
     }
 }

@@ -1,0 +1,338 @@
+//! UsdLux lights and UsdGeom cameras, as scene lights and cameras.
+
+use glam::{Affine3A, Mat4, Vec3};
+use openusd::sdf;
+
+use super::{DISK_SEGMENTS, UsdLoader, as_bool, as_vec3};
+use crate::scene::{Camera, Light, LightKind, Material, Projection};
+
+impl UsdLoader {
+    /// A UsdLux light's `intensity × 2^exposure × color`, tinted by its colour temperature
+    /// when enabled.
+    pub(super) fn light_strength(&self, prim: &sdf::Path) -> Vec3 {
+        let intensity = self.get_f32(prim, "inputs:intensity").unwrap_or(1.0);
+        let exposure = self.get_f32(prim, "inputs:exposure").unwrap_or(0.0);
+        let colour = self
+            .get(prim, "inputs:color")
+            .as_ref()
+            .and_then(as_vec3)
+            .unwrap_or(Vec3::ONE);
+        // Colour temperature tints relative to 6500 K, USD's default white point, which
+        // Blender writes on every light and Cycles renders white.
+        let enabled = self
+            .get(prim, "inputs:enableColorTemperature")
+            .as_ref()
+            .and_then(as_bool);
+        let colour = if enabled == Some(true) {
+            let kelvin = self
+                .get_f32(prim, "inputs:colorTemperature")
+                .unwrap_or(6500.0);
+            colour * blackbody_tint(kelvin)
+        } else {
+            colour
+        };
+        colour * intensity * exposure.exp2()
+    }
+
+    /// A `DomeLight` of constant colour: radiance intensity × 2^exposure × color from every
+    /// direction the scene leaves open. A texture (an environment map) is not read.
+    pub(super) fn add_dome(&mut self, prim: &sdf::Path) {
+        let where_ = prim.as_str();
+        let radiance = self.light_strength(prim);
+        if self.get(prim, "inputs:texture:file").is_some() {
+            self.warn(format!(
+                "{where_}: DomeLight texture maps are not supported; using its constant colour"
+            ));
+        }
+        if radiance.is_finite() && radiance.min_element() >= 0.0 {
+            self.builder.add_environment(radiance);
+        } else {
+            self.warn(format!(
+                "{where_}: negative or non-finite dome light; skipped"
+            ));
+        }
+    }
+
+    pub(super) fn add_camera(&mut self, prim: &sdf::Path, world: Mat4) {
+        let where_ = prim.as_str().to_string();
+        // Apertures and focal length share a unit (tenths of a scene unit), so their ratio
+        // is the field of view; the defaults are USD's.
+        let focal = self.get_f32(prim, "focalLength").unwrap_or(50.0);
+        let horizontal = self.get_f32(prim, "horizontalAperture").unwrap_or(20.955);
+        let vertical = self.get_f32(prim, "verticalAperture").unwrap_or(15.2908);
+        let znear = match self.get(prim, "clippingRange") {
+            Some(sdf::Value::Vec2f(r)) => r.x,
+            Some(sdf::Value::Vec2d(r)) => r.x as f32,
+            _ => 1.0,
+        };
+        let (scale, rotation, translation) = world.to_scale_rotation_translation();
+        let projection = if self.get_token(prim, "projection").as_deref() == Some("orthographic") {
+            // Apertures in tenths of a scene unit, here after the stage's scale.
+            Projection::Orthographic {
+                xmag: 0.05 * horizontal * scale.x,
+                ymag: 0.05 * vertical * scale.y,
+            }
+        } else {
+            if !(focal > 0.0 && vertical > 0.0 && horizontal > 0.0) {
+                self.warn(format!(
+                    "{where_}: camera with zero focal length or aperture; skipped"
+                ));
+                return;
+            }
+            Projection::Perspective {
+                yfov: 2.0 * (0.5 * vertical / focal).atan(),
+                aspect_ratio: Some(horizontal / vertical),
+            }
+        };
+        self.builder.add_camera(Camera {
+            name: where_.clone(),
+            world_from_camera: Affine3A::from_rotation_translation(
+                rotation.normalize(),
+                translation,
+            ),
+            projection,
+            znear: znear * scale.y,
+            source: where_,
+        });
+    }
+
+    /// UsdLux lights. Radiance (area lights) or radiant intensity (points) is
+    /// `intensity × 2^exposure × color`; `normalize` divides by the light's area, so that
+    /// the power (π × radiance × area) stays `π × intensity` whatever its size — which is
+    /// how Blender writes watts (intensity = W/π).
+    pub(super) fn add_light(&mut self, prim: &sdf::Path, kind: &str, world: Mat4) {
+        let where_ = prim.as_str().to_string();
+        let normalize = self
+            .get(prim, "inputs:normalize")
+            .as_ref()
+            .and_then(as_bool)
+            .unwrap_or(false);
+        let strength = self.light_strength(prim);
+        if !strength.is_finite() || strength.min_element() < 0.0 {
+            self.warn(format!(
+                "{where_}: negative or non-finite light strength; skipped"
+            ));
+            return;
+        }
+        let transform = Affine3A::from_mat4(world);
+        // World-space area scale of the light's local XY plane.
+        let area_scale = transform
+            .matrix3
+            .x_axis
+            .cross(transform.matrix3.y_axis)
+            .length();
+        let emitter =
+            |loader: &mut UsdLoader, positions: Vec<Vec3>, indices: Vec<[u32; 3]>, area: f32| {
+                let radiance = if normalize {
+                    strength / (area * area_scale).max(f32::MIN_POSITIVE)
+                } else {
+                    strength
+                };
+                let material = loader.builder.add_material(Material {
+                    double_sided: false,
+                    ..Material::diffuse(where_.clone(), Vec3::ZERO).with_emission(radiance)
+                });
+                let mesh = loader
+                    .builder
+                    .add_mesh(where_.clone(), positions, indices, material);
+                loader.builder.add_instance(mesh, transform, where_.clone());
+            };
+        match kind {
+            "RectLight" => {
+                let w = 0.5 * self.get_f32(prim, "inputs:width").unwrap_or(1.0);
+                let h = 0.5 * self.get_f32(prim, "inputs:height").unwrap_or(1.0);
+                // In the XY plane, emitting towards −Z: wound clockwise seen from +Z.
+                let positions = vec![
+                    Vec3::new(-w, -h, 0.0),
+                    Vec3::new(-w, h, 0.0),
+                    Vec3::new(w, h, 0.0),
+                    Vec3::new(w, -h, 0.0),
+                ];
+                emitter(self, positions, vec![[0, 1, 2], [0, 2, 3]], 4.0 * w * h);
+            }
+            "DiskLight" => {
+                let r = self.get_f32(prim, "inputs:radius").unwrap_or(0.5);
+                let mut positions = vec![Vec3::ZERO];
+                positions.extend((0..DISK_SEGMENTS).map(|i| {
+                    let a = -std::f32::consts::TAU * i as f32 / DISK_SEGMENTS as f32;
+                    Vec3::new(r * a.cos(), r * a.sin(), 0.0)
+                }));
+                let indices = (0..DISK_SEGMENTS)
+                    .map(|i| [0, 1 + i, 1 + (i + 1) % DISK_SEGMENTS])
+                    .collect();
+                let area = 0.5
+                    * DISK_SEGMENTS as f32
+                    * r
+                    * r
+                    * (std::f32::consts::TAU / DISK_SEGMENTS as f32).sin();
+                emitter(self, positions, indices, area);
+            }
+            "SphereLight" => {
+                let local_radius = self.get_f32(prim, "inputs:radius").unwrap_or(0.5);
+                let r = local_radius * area_scale.sqrt();
+                let shaped = self
+                    .get_f32(prim, "inputs:shaping:cone:angle")
+                    .is_some_and(|a| a < 180.0);
+                let as_point =
+                    self.get(prim, "treatAsPoint").as_ref().and_then(as_bool) == Some(true);
+                if !as_point && !shaped && r > 0.0 {
+                    // A real sphere: an emitter of radiance L over its surface (one-sided,
+                    // outwards), as Cycles renders a point light with a radius.
+                    let (positions, indices) = uv_sphere(local_radius);
+                    let area = 4.0 * std::f32::consts::PI * local_radius * local_radius;
+                    emitter(self, positions, indices, area);
+                    return;
+                }
+                // A sphere of radiance L emits π·L·4πr² in all, i.e. L·πr² per steradian;
+                // normalized, L = intensity / 4πr², so intensity / 4 per steradian.
+                let per_steradian = if normalize || r == 0.0 {
+                    strength / 4.0
+                } else {
+                    strength * std::f32::consts::PI * r * r
+                };
+                if shaped && !as_point && r > 0.0 {
+                    self.warn(format!(
+                        "{where_}: shaped SphereLight of radius {r} is rendered as a point spot light"
+                    ));
+                }
+                let position = transform.transform_point3(Vec3::ZERO);
+                let kind = match self.get_f32(prim, "inputs:shaping:cone:angle") {
+                    Some(angle) if angle < 180.0 => {
+                        let softness = self
+                            .get_f32(prim, "inputs:shaping:cone:softness")
+                            .unwrap_or(0.0)
+                            .clamp(0.0, 1.0);
+                        let outer = angle.to_radians().min(std::f32::consts::FRAC_PI_2);
+                        LightKind::Spot {
+                            position,
+                            direction: transform.transform_vector3(Vec3::NEG_Z).normalize_or_zero(),
+                            intensity: per_steradian,
+                            cos_inner: (outer * (1.0 - softness)).cos(),
+                            cos_outer: outer.cos(),
+                            range: None,
+                        }
+                    }
+                    _ => LightKind::Point {
+                        position,
+                        intensity: per_steradian,
+                        range: None,
+                    },
+                };
+                self.builder.add_light(Light {
+                    name: where_.clone(),
+                    kind,
+                    source: where_,
+                });
+            }
+            "DistantLight" => {
+                let direction = transform.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+                // Irradiance is intensity × 2^exposure × colour, except from Blender, whose
+                // exporter writes a sun of S W/m² as intensity S/4 (and reads it back × 4).
+                let irradiance = if self.from_blender {
+                    4.0 * strength
+                } else {
+                    strength
+                };
+                self.builder.add_light(Light {
+                    name: where_.clone(),
+                    kind: LightKind::Directional {
+                        direction,
+                        irradiance,
+                    },
+                    source: where_,
+                });
+            }
+            _ => {}
+        }
+    }
+}
+
+/// A UV sphere of `radius` about the origin, wound outwards.
+fn uv_sphere(radius: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let (rings, segments) = (16u32, 32u32);
+    let mut positions = Vec::new();
+    for ring in 0..=rings {
+        let theta = std::f32::consts::PI * ring as f32 / rings as f32;
+        for segment in 0..=segments {
+            let phi = std::f32::consts::TAU * segment as f32 / segments as f32;
+            positions.push(
+                radius
+                    * Vec3::new(
+                        theta.sin() * phi.cos(),
+                        theta.sin() * phi.sin(),
+                        theta.cos(),
+                    ),
+            );
+        }
+    }
+    let row = segments + 1;
+    let mut indices = Vec::new();
+    for ring in 0..rings {
+        for segment in 0..segments {
+            let (a, b) = (ring * row + segment, (ring + 1) * row + segment);
+            indices.push([a, b, b + 1]);
+            indices.push([a, b + 1, a + 1]);
+        }
+    }
+    (positions, indices)
+}
+
+/// The colour of a blackbody at `kelvin` (clamped to 1667–25000 K) relative to one at
+/// 6500 K, in linear sRGB: the Planckian locus approximation of Kim et al. (2002) gives its
+/// chromaticity, the sRGB matrix (IEC 61966-2-1) its colour at unit luminance.
+fn blackbody_tint(kelvin: f32) -> Vec3 {
+    pub(super) fn rgb(kelvin: f64) -> Vec3 {
+        let t = kelvin.clamp(1667.0, 25000.0);
+        let (t2, t3) = (t * t, t * t * t);
+        let x = if t <= 4000.0 {
+            -0.2661239e9 / t3 - 0.2343589e6 / t2 + 0.8776956e3 / t + 0.179910
+        } else {
+            -3.0258469e9 / t3 + 2.1070379e6 / t2 + 0.2226347e3 / t + 0.240390
+        };
+        let y = if t <= 2222.0 {
+            -1.1063814 * x * x * x - 1.34811020 * x * x + 2.18555832 * x - 0.20219683
+        } else if t <= 4000.0 {
+            -0.9549476 * x * x * x - 1.37418593 * x * x + 2.09137015 * x - 0.16748867
+        } else {
+            3.0817580 * x * x * x - 5.87338670 * x * x + 3.75112997 * x - 0.37001483
+        };
+        let (cx, cy, cz) = (x / y, 1.0, (1.0 - x - y) / y);
+        Vec3::new(
+            (3.2404542 * cx - 1.5371385 * cy - 0.4985314 * cz) as f32,
+            (-0.9692660 * cx + 1.8760108 * cy + 0.0415560 * cz) as f32,
+            (0.0556434 * cx - 0.2040259 * cy + 1.0572252 * cz) as f32,
+        )
+        .max(Vec3::ZERO)
+    }
+    if !kelvin.is_finite() {
+        return Vec3::ONE;
+    }
+    rgb(kelvin as f64) / rgb(6500.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    pub(super) fn sphere_lights_are_wound_outwards() {
+        let (positions, indices) = uv_sphere(2.0);
+        // Each non-degenerate triangle's normal points away from the centre.
+        for t in &indices {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            let n = (b - a).cross(c - a);
+            if n.length() > 1e-6 {
+                assert!(n.dot(a + b + c) > 0.0, "{t:?}");
+            }
+        }
+    }
+
+    #[test]
+    pub(super) fn colour_temperature_is_warm_below_and_cool_above_6500_kelvin() {
+        assert!((blackbody_tint(6500.0) - Vec3::ONE).abs().max_element() < 1e-6);
+        let candle = blackbody_tint(2000.0);
+        assert!(candle.x > 1.0 && candle.z < 0.3 * candle.x, "{candle}");
+        let sky = blackbody_tint(12000.0);
+        assert!(sky.z > sky.x, "{sky}");
+    }
+}

@@ -1,0 +1,300 @@
+//! UsdPreviewSurface materials and their UsdUVTexture inputs, as scene materials.
+
+use std::path::Path;
+
+use glam::{Affine2, Vec2, Vec3};
+use openusd::sdf;
+
+use super::{UsdLoader, as_vec3};
+use crate::limits::memory_budget;
+use crate::load::access::read_regular_file;
+use crate::load::images::decode_texture;
+use crate::scene::{
+    AlphaMode, ColorSpace, Material, MaterialKind, MaterialTextures, TextureRef, Wrap,
+};
+
+impl UsdLoader {
+    /// The one-sided variant of material `index`, made once. UsdGeom's `doubleSided` (false
+    /// by default; Blender writes true) belongs to the mesh, gridtrace's to the material:
+    /// one-sided means what it does for glTF (a black back face), except for glass, whose
+    /// back faces are the inside of its volume.
+    pub(super) fn one_sided(&mut self, index: usize) -> usize {
+        if let Some(&variant) = self.one_sided.get(&index) {
+            return variant;
+        }
+        let mut material = self.builder.material_mut(index).clone();
+        let variant = if matches!(material.kind, MaterialKind::Glass { .. }) {
+            index
+        } else {
+            material.double_sided = false;
+            material.name = format!("{} (one-sided)", material.name);
+            self.builder.add_material(material)
+        };
+        self.one_sided.insert(index, variant);
+        variant
+    }
+
+    /// The material bound to `prim` (`material:binding`), converted once per material.
+    pub(super) fn bound_material(&mut self, prim: &sdf::Path) -> usize {
+        let target = prim
+            .append_property("material:binding")
+            .ok()
+            .and_then(|rel| self.stage.relationship(rel).targets().ok())
+            .and_then(|t| t.into_iter().next());
+        let Some(target) = target else {
+            return self.default_material();
+        };
+        let key = target.as_str().to_string();
+        if let Some(&m) = self.materials.get(&key) {
+            return m;
+        }
+        let material = self.convert_material(&target);
+        let index = self.builder.add_material(material);
+        self.materials.insert(key, index);
+        index
+    }
+
+    pub(super) fn default_material(&mut self) -> usize {
+        if let Some(m) = self.default_material {
+            return m;
+        }
+        let m = self
+            .builder
+            .add_material(Material::diffuse("default", Vec3::splat(0.8)));
+        self.default_material = Some(m);
+        m
+    }
+
+    /// A `UsdPreviewSurface` material, mapped as glTF's are.
+    pub(super) fn convert_material(&mut self, material: &sdf::Path) -> Material {
+        let name = material.as_str().to_string();
+        let surface = self.connected_prim(material, "outputs:surface");
+        let Some(shader) = surface else {
+            self.warn(format!(
+                "{name}: material has no surface shader; using grey diffuse"
+            ));
+            return Material::diffuse(name, Vec3::splat(0.8));
+        };
+        let id = self.get_token(&shader, "info:id").unwrap_or_default();
+        if id != "UsdPreviewSurface" {
+            self.warn(format!(
+                "{name}: surface shader '{id}' is not UsdPreviewSurface; using grey diffuse"
+            ));
+            return Material::diffuse(name, Vec3::splat(0.8));
+        }
+        let mut textures = MaterialTextures {
+            metallic_factor: 0.0,
+            normal_scale: 1.0,
+            ..MaterialTextures::default()
+        };
+        // A connected input is a texture (its scale as the factor); else a constant.
+        let diffuse =
+            match self.texture_input(&shader, "inputs:diffuseColor", ColorSpace::Srgb, &name) {
+                Some((r, scale)) => {
+                    textures.base_colour = Some(r);
+                    scale
+                }
+                None => self.constant_colour(&shader, "inputs:diffuseColor", Vec3::splat(0.18)),
+            };
+        let emission =
+            match self.texture_input(&shader, "inputs:emissiveColor", ColorSpace::Srgb, &name) {
+                Some((r, scale)) => {
+                    textures.emissive = Some(r);
+                    scale
+                }
+                None => self.constant_colour(&shader, "inputs:emissiveColor", Vec3::ZERO),
+            };
+        if let Some((r, _)) =
+            self.texture_input(&shader, "inputs:normal", ColorSpace::Linear, &name)
+        {
+            textures.normal = Some(r);
+        }
+        let mut alpha_mode = AlphaMode::Opaque;
+        let mut opacity = self.get_f32(&shader, "inputs:opacity").unwrap_or(1.0);
+        if let Some((r, _)) =
+            self.texture_input(&shader, "inputs:opacity", ColorSpace::Linear, &name)
+        {
+            // Opacity from a texture's alpha (Blender's wiring) cuts out at the threshold,
+            // or blends without one. The base-colour texture carries that alpha here.
+            if textures.base_colour.is_none_or(|b| b.texture == r.texture) {
+                textures.base_colour.get_or_insert(r);
+                let threshold = self
+                    .get_f32(&shader, "inputs:opacityThreshold")
+                    .unwrap_or(0.0);
+                alpha_mode = if threshold > 0.0 {
+                    AlphaMode::Mask { cutoff: threshold }
+                } else {
+                    AlphaMode::Blend
+                };
+            } else {
+                self.warn(format!(
+                    "{name}: opacity from a texture other than the diffuse one is not supported"
+                ));
+            }
+            opacity = 1.0;
+        }
+        let metallic = self.constant_scalar(&shader, "inputs:metallic", 0.0, &name);
+        let ior = self.constant_scalar(&shader, "inputs:ior", 1.5, &name);
+        let roughness = self.constant_scalar(&shader, "inputs:roughness", 0.5, &name);
+        let kind = if opacity < 0.5 {
+            MaterialKind::Glass { ior, tint: diffuse }
+        } else if metallic >= 0.5 {
+            MaterialKind::Mirror {
+                reflectance: diffuse,
+            }
+        } else {
+            MaterialKind::Diffuse { albedo: diffuse }
+        };
+        if !matches!(kind, MaterialKind::Diffuse { .. }) && roughness > 0.05 {
+            self.warn(format!(
+                "{name}: roughness {roughness} is rendered as perfectly smooth (gridtrace's mirror and glass are ideal)"
+            ));
+        }
+        Material {
+            emission,
+            textures,
+            alpha_mode,
+            ..Material::new(name, kind)
+        }
+    }
+
+    pub(super) fn constant_colour(
+        &mut self,
+        shader: &sdf::Path,
+        input: &str,
+        default: Vec3,
+    ) -> Vec3 {
+        self.get(shader, input)
+            .as_ref()
+            .and_then(as_vec3)
+            .unwrap_or(default)
+    }
+
+    pub(super) fn constant_scalar(
+        &mut self,
+        shader: &sdf::Path,
+        input: &str,
+        default: f32,
+        material: &str,
+    ) -> f32 {
+        self.warn_if_connected(shader, input, material);
+        self.get_f32(shader, input).unwrap_or(default)
+    }
+
+    /// The `UsdUVTexture` feeding `input`, as a texture reference and the colour factor its
+    /// `scale` gives; `None` when the input is not connected (or cannot be used, with a
+    /// warning). The texture's `st` may pass through a `UsdTransform2d` and comes from a
+    /// `UsdPrimvarReader_float2` of `st` (the set the loader reads).
+    pub(super) fn texture_input(
+        &mut self,
+        shader: &sdf::Path,
+        input: &str,
+        space: ColorSpace,
+        material: &str,
+    ) -> Option<(TextureRef, Vec3)> {
+        let node = self.connected_prim(shader, input)?;
+        if self.get_token(&node, "info:id").as_deref() != Some("UsdUVTexture") {
+            self.warn(format!(
+                "{material}: {input} is connected to something other than a UsdUVTexture; ignored"
+            ));
+            return None;
+        }
+        let file = match self.get(&node, "inputs:file") {
+            Some(sdf::Value::AssetPath(a)) => a.authored_path.clone(),
+            _ => {
+                self.warn(format!(
+                    "{material}: {input}'s texture has no file; ignored"
+                ));
+                return None;
+            }
+        };
+        let texture = self.texture_file(&file, material)?;
+        if matches!(space, ColorSpace::Srgb)
+            && self.get_token(&node, "inputs:sourceColorSpace").as_deref() == Some("raw")
+        {
+            self.warn(format!(
+                "{material}: {input} reads '{file}' as raw data; treated as sRGB colour"
+            ));
+        }
+        let scale = match self.get(&node, "inputs:scale") {
+            Some(sdf::Value::Vec4f(v)) => Vec3::new(v.x, v.y, v.z),
+            _ => Vec3::ONE,
+        };
+        let wrap = |mode: Option<String>| match mode.as_deref() {
+            Some("clamp") => Wrap::ClampToEdge,
+            Some("mirror") => Wrap::MirroredRepeat,
+            _ => Wrap::Repeat,
+        };
+        let mut reference = TextureRef::new(texture);
+        reference.wrap_u = wrap(self.get_token(&node, "inputs:wrapS"));
+        reference.wrap_v = wrap(self.get_token(&node, "inputs:wrapT"));
+        // USD's st has v up the image, ours down: uv → st → UsdTransform2d → uv.
+        let flip = Affine2::from_cols(Vec2::X, Vec2::NEG_Y, Vec2::Y);
+        let st = self.connected_prim(&node, "inputs:st");
+        if let Some(st) = st
+            && self.get_token(&st, "info:id").as_deref() == Some("UsdTransform2d")
+        {
+            let scale = match self.get(&st, "inputs:scale") {
+                Some(sdf::Value::Vec2f(v)) => Vec2::new(v.x, v.y),
+                _ => Vec2::ONE,
+            };
+            let translation = match self.get(&st, "inputs:translation") {
+                Some(sdf::Value::Vec2f(v)) => Vec2::new(v.x, v.y),
+                _ => Vec2::ZERO,
+            };
+            let rotation = self
+                .get_f32(&st, "inputs:rotation")
+                .unwrap_or(0.0)
+                .to_radians();
+            let transform = Affine2::from_scale_angle_translation(scale, rotation, translation);
+            reference.transform = flip * transform * flip;
+        }
+        let factor = if matches!(space, ColorSpace::Srgb) {
+            scale
+        } else {
+            Vec3::ONE
+        };
+        Some((reference, factor))
+    }
+
+    /// The scene texture of an image file relative to the stage, decoded once.
+    pub(super) fn texture_file(&mut self, file: &str, material: &str) -> Option<usize> {
+        if let Some(&known) = self.textures.get(file) {
+            return known;
+        }
+        let base = self.path.parent().unwrap_or(Path::new("."));
+        let bytes = self.roots.resolve(base, file).and_then(|full| {
+            self.texture_paths.push(full.clone());
+            read_regular_file(&full, file, memory_budget())
+        });
+        let decoded = match bytes.map_err(|e| e.to_string()).and_then(|bytes| {
+            decode_texture(file.to_string(), &bytes).map_err(|e| format!("'{file}' {e}"))
+        }) {
+            Ok(texture) => Some(self.builder.add_texture(texture)),
+            Err(why) => {
+                self.warn(format!(
+                    "{material}: texture {why}; using a neutral texture"
+                ));
+                None
+            }
+        };
+        self.textures.insert(file.to_string(), decoded);
+        decoded
+    }
+
+    /// The prim whose output feeds `property` of `prim` (its first connection), if any.
+    pub(super) fn connected_prim(&self, prim: &sdf::Path, property: &str) -> Option<sdf::Path> {
+        let attribute = self.stage.attribute(prim.append_property(property).ok()?);
+        let source = attribute.connections().ok()?.into_iter().next()?;
+        Some(source.prim_path())
+    }
+
+    /// Networks feeding a scalar input are not read: say so.
+    pub(super) fn warn_if_connected(&mut self, shader: &sdf::Path, input: &str, material: &str) {
+        if self.connected_prim(shader, input).is_some() {
+            self.warn(format!(
+                "{material}: {input} is connected to a shader network (textures are not read from USD yet); using its constant value"
+            ));
+        }
+    }
+}
