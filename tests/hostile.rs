@@ -93,6 +93,10 @@ const CASES: &[(&str, Expect)] = &[
         Expect::Error("nested 10000 levels deep"),
     ),
     (
+        "usd_deep_hierarchy.usda",
+        Expect::Error("/P0/…/P257: prim hierarchy deeper than 256"),
+    ),
+    (
         "usd_deep_dictionary.usda",
         Expect::Error("levels deep, more than the 500"),
     ),
@@ -591,7 +595,12 @@ fn a_signal_while_loading_quits_at_once() {
 fn a_killed_checkpointed_render_resumes_into_the_uninterrupted_image() {
     let out = tempfile::tempdir().unwrap();
     let (child, checkpoint, started) = start_long_render(out.path(), &["--checkpoint", "0.05"]);
-    std::thread::sleep(Duration::from_millis(800));
+    // Kill it some time after its first checkpoint, wherever it then is.
+    while !checkpoint.exists() {
+        assert!(started.elapsed() < TIME_LIMIT, "no checkpoint was written");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::thread::sleep(Duration::from_millis(300));
     // SAFETY: kills our own child, giving it no chance to write anything more.
     unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGKILL) };
     let run = wait_limited(child, &out.path().join("stderr.txt"), started);

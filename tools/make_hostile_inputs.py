@@ -197,6 +197,8 @@ def Mesh "Floor"
         write(j("corrupt.usdc"), f.read())
     write(j("usd_corrupt_reference.usda"), usda("def Xform \"Ref\" (\n    prepend references = @corrupt.usdc@\n)\n{\n}\n"))
     write(j("usd_corrupt_sublayer.usda"), usda(metadata="    subLayers = [@corrupt.usdc@]\n"))
+    # Deep, but not past the parser's limit: the prim walk's own limit answers.
+    write(j("usd_deep_hierarchy.usda"), usda("".join(f"def Xform \"P{i}\" {{\n" for i in range(300)) + "}\n" * 300))
     depth = 10000
     write(j("usd_deep_prims.usda"), usda("".join(f"def Xform \"P{i}\" {{\n" for i in range(depth)) + "}\n" * depth))
     write(j("usd_deep_dictionary.usda"),

@@ -386,7 +386,10 @@ impl UsdLoader {
         let path = prim.path().clone();
         let where_ = path.as_str().to_string();
         if depth > MAX_DEPTH {
-            return Err(self.invalid(format!("{where_}: prim hierarchy deeper than {MAX_DEPTH}")));
+            // The path itself would be hundreds of names long: show its ends.
+            let names: Vec<&str> = where_.split('/').filter(|n| !n.is_empty()).collect();
+            let short = format!("/{}/…/{}", names[0], names[names.len() - 1]);
+            return Err(self.invalid(format!("{short}: prim hierarchy deeper than {MAX_DEPTH}")));
         }
         if !prim.is_active().unwrap_or(true) {
             return Ok(());
