@@ -52,11 +52,22 @@ pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadE
         };
         // The reader's own last words (an allocation failure's message and backtrace) are
         // not the user's business: the parent reports the crash in one line.
-        // SAFETY: opens /dev/null and moves it onto this process's stderr descriptor.
+        // SAFETY: opens /dev/null and moves it onto this process's stderr descriptor; puts
+        // back the default action of the signals a crash raises, so that handlers the host
+        // installed (a fuzzer's, a debugger's) do not turn the crash into something else.
         unsafe {
             let null = libc::open(c"/dev/null".as_ptr(), libc::O_WRONLY);
             if null >= 0 {
                 libc::dup2(null, libc::STDERR_FILENO);
+            }
+            for signal in [
+                libc::SIGABRT,
+                libc::SIGSEGV,
+                libc::SIGBUS,
+                libc::SIGILL,
+                libc::SIGFPE,
+            ] {
+                libc::signal(signal, libc::SIG_DFL);
             }
         }
         let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(load));
@@ -86,16 +97,23 @@ pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadE
         }
         std::thread::sleep(Duration::from_millis(2));
     };
-    if waited == pid && libc::WIFSIGNALED(status) {
-        return Err(LoadError::Invalid {
+    // The child leaves with status 0 whatever the load gave; anything else is a crash.
+    let how = if libc::WIFSIGNALED(status) {
+        Some(format!("signal {}", libc::WTERMSIG(status)))
+    } else if libc::WIFEXITED(status) && libc::WEXITSTATUS(status) != 0 {
+        Some(format!("exit status {}", libc::WEXITSTATUS(status)))
+    } else {
+        None
+    };
+    match how {
+        Some(how) if waited == pid => Err(LoadError::Invalid {
             path: path.to_path_buf(),
             what: format!(
-                "the USD reader crashed on this stage or a layer it uses (signal {}); a layer is probably corrupt",
-                libc::WTERMSIG(status)
+                "the USD reader crashed on this stage or a layer it uses ({how}); a layer is probably corrupt"
             ),
-        });
+        }),
+        _ => Ok(()),
     }
-    Ok(())
 }
 
 #[cfg(not(unix))]
