@@ -81,6 +81,8 @@ pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadE
     // otherwise hang the load. After the deadline it is killed and the file read in-process.
     let deadline = Instant::now() + PROBE_DEADLINE;
     let mut status = 0;
+    // Poll often at first (most stages read in well under a millisecond), then less.
+    let mut pause = Duration::from_micros(20);
     let waited = loop {
         // SAFETY: polls the child forked above, with a valid status pointer.
         let waited = unsafe { libc::waitpid(pid, &mut status, libc::WNOHANG) };
@@ -95,7 +97,8 @@ pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadE
             }
             return Ok(());
         }
-        std::thread::sleep(Duration::from_millis(2));
+        std::thread::sleep(pause);
+        pause = (pause * 2).min(Duration::from_millis(2));
     };
     // The child leaves with status 0 whatever the load gave; anything else is a crash.
     let how = if libc::WIFSIGNALED(status) {
