@@ -341,6 +341,27 @@ fn every_hostile_scene_ends_in_a_clear_outcome_within_time_and_memory() {
 }
 
 #[test]
+fn a_reader_that_loops_is_ended_by_the_load_timeout() {
+    let hangs = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_hangs");
+    let out = tempfile::tempdir().unwrap();
+    for name in ["material_connection_loop.usda", "slow_binary_layer.usdc"] {
+        let image = out.path().join("never.png");
+        let args = [name, "-o", image.to_str().unwrap(), "--load-timeout", "2"];
+        let run = run_limited(&args, &hangs);
+        assert_eq!(run.code, Some(2), "{name}: {}", run.stderr);
+        assert!(
+            run.stderr
+                .starts_with(&format!("error: {name}: loading did not finish within 2 s"))
+                && run.stderr.lines().count() == 1,
+            "{name}: {}",
+            run.stderr
+        );
+        assert!(run.elapsed < Duration::from_secs(10), "{:?}", run.elapsed);
+        assert!(!image.exists());
+    }
+}
+
+#[test]
 fn an_asset_path_lets_a_scene_read_another_folder() {
     let scenes = scenes();
     let out = tempfile::tempdir().unwrap();

@@ -114,6 +114,11 @@ pub struct Args {
     #[arg(long, value_name = "SIZE", value_parser = parse_size)]
     pub max_memory: Option<u64>,
 
+    /// Give up, with an error, if loading and preparing the scene take longer than this: a
+    /// file on which a third-party reader loops must not hang a farm job.
+    #[arg(long, value_name = "SECONDS", default_value_t = 600.0, value_parser = parse_seconds)]
+    pub load_timeout: f64,
+
     /// Every SECONDS, write the image so far to the output (atomically, as a part that
     /// `gridtrace merge` accepts), so a killed render keeps its samples.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]

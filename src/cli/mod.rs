@@ -75,8 +75,10 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
             bail!("{}: --asset-path is not a folder", dir.display());
         }
     }
+    signals::arm_load_timeout(Duration::from_secs_f64(args.load_timeout), scene_path);
     if args.inspect {
         let loaded = load_scene_with(scene_path, &options)?;
+        set_phase(Phase::Finished);
         print!(
             "{}:\n{}",
             scene_path.display(),

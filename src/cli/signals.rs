@@ -5,8 +5,10 @@
 //! every write holds, so no temporary file survives and no message claims the output was
 //! not replaced when it was.
 
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, Ordering};
 use std::sync::{Mutex, MutexGuard};
+use std::time::Duration;
 
 use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
 
@@ -50,6 +52,24 @@ pub fn output_lock() -> MutexGuard<'static, ()> {
 /// SIGTERM, 129 for SIGHUP), as shells report it.
 pub fn interrupted_exit_code() -> i32 {
     128 + SIGNAL.load(Ordering::SeqCst).max(0)
+}
+
+/// Ends the process with an error naming `scene` if it is still preparing (loading the
+/// scene, building the grid) after `limit`: the readers are third-party code, and one that
+/// loops on a crafted file cannot be interrupted any other way.
+pub fn arm_load_timeout(limit: Duration, scene: &Path) {
+    let scene = scene.display().to_string();
+    std::thread::spawn(move || {
+        std::thread::sleep(limit);
+        let _writing = output_lock();
+        if PHASE.load(Ordering::SeqCst) == Phase::Preparing as u8 {
+            eprintln!(
+                "error: {scene}: loading did not finish within {} s (--load-timeout); a reader may be looping on this file",
+                limit.as_secs_f64()
+            );
+            std::process::exit(2);
+        }
+    });
 }
 
 /// Installs the handlers: a thread that waits for the signals and acts on them.

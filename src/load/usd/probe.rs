@@ -6,13 +6,9 @@
 //! load, not only the file named on the command line.
 
 use std::path::Path;
-use std::time::{Duration, Instant};
 
 use super::resolver::is_layer;
 use crate::load::LoadError;
-
-/// Longest the probe may take before it is given up on (and the stage read in-process).
-const PROBE_DEADLINE: Duration = Duration::from_secs(120);
 
 /// False only for a text layer that names no other layer (no `@….usd[acz]@` asset path):
 /// such a stage holds nothing the binary reader sees, and need not be read twice.
@@ -36,8 +32,8 @@ pub fn may_hold_binary_layers(path: &Path) -> bool {
 }
 
 /// Runs `load` in a forked child; a child killed by a signal (an abort, a stack overflow,
-/// the memory limit) becomes an error naming `path`. Without a child to spare, or if the
-/// child outlives the deadline, the caller's own read decides.
+/// the memory limit) becomes an error naming `path`. Without a child to spare, the caller's
+/// own read decides.
 #[cfg(unix)]
 pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadError> {
     // SAFETY: fork has no preconditions; the child below only reads files and leaves with
@@ -77,28 +73,18 @@ pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadE
     if pid < 0 {
         return Ok(());
     }
-    // Wait, but not forever: a child stuck on a lock another thread held at the fork would
-    // otherwise hang the load. After the deadline it is killed and the file read in-process.
-    let deadline = Instant::now() + PROBE_DEADLINE;
+    // Wait as long as the read takes: the reader can be slow on a large stage, and a stage
+    // on which it loops is ended by the command line's load timeout (`--load-timeout`),
+    // which takes this child with it. The threads alive at the fork (signal handling, idle
+    // workers) hold no lock the child needs.
     let mut status = 0;
-    // Poll often at first (most stages read in well under a millisecond), then less.
-    let mut pause = Duration::from_micros(20);
     let waited = loop {
-        // SAFETY: polls the child forked above, with a valid status pointer.
-        let waited = unsafe { libc::waitpid(pid, &mut status, libc::WNOHANG) };
-        if waited != 0 {
+        // SAFETY: waits for the child forked above, with a valid status pointer.
+        let waited = unsafe { libc::waitpid(pid, &mut status, 0) };
+        if waited >= 0 || std::io::Error::last_os_error().kind() != std::io::ErrorKind::Interrupted
+        {
             break waited;
         }
-        if Instant::now() > deadline {
-            // SAFETY: signals and reaps our own child.
-            unsafe {
-                libc::kill(pid, libc::SIGKILL);
-                libc::waitpid(pid, &mut status, 0);
-            }
-            return Ok(());
-        }
-        std::thread::sleep(pause);
-        pause = (pause * 2).min(Duration::from_millis(2));
     };
     // The child leaves with status 0 whatever the load gave; anything else is a crash.
     let how = if libc::WIFSIGNALED(status) {
