@@ -11,7 +11,6 @@ what gridtrace must do with each case. Everything here is written from scratch e
 corrupt binary USD layer, which is the fuzzer's crasher in tests/fuzz_crashes/usd/.
 """
 
-import base64
 import gzip
 import json
 import math
@@ -21,39 +20,22 @@ import struct
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_bad_inputs import QUAD, QUAD_INDICES, buffer_bytes, document  # noqa: E402
 
 # Words a leak would show: as text, and as the little-endian integers an index accessor
 # would make of them (tests/hostile.rs checks neither appears in any message).
 SECRET = b"TOPSECRET-canary-7f3a-gridtrace-hostile-input-corpus!!!!"
-QUAD = [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]
-QUAD_INDICES = [0, 1, 2, 0, 2, 3]
 
 
 def quad_bytes():
-    data = b"".join(struct.pack("<3f", *p) for p in QUAD)
-    return data + b"".join(struct.pack("<H", i) for i in QUAD_INDICES)
+    return buffer_bytes(QUAD, QUAD_INDICES)
 
 
 def gltf(buffer_uri="quad.bin", byte_length=60, **overrides):
-    """An emissive quad seen by a default camera; `overrides` replace top-level keys."""
-    doc = {
-        "asset": {"version": "2.0"},
-        "buffers": [{"uri": buffer_uri, "byteLength": byte_length}],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
-            {"buffer": 0, "byteOffset": 48, "byteLength": 12},
-        ],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
-            {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
-        ],
-        "materials": [{"emissiveFactor": [1, 1, 1], "pbrMetallicRoughness": {"metallicFactor": 0}}],
-        "meshes": [{"name": "quad", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
-        "nodes": [{"mesh": 0}],
-        "scenes": [{"nodes": [0]}],
-        "scene": 0,
-    }
-    doc.update(overrides)
+    """tools/make_bad_inputs.py's emissive quad, its buffer in the file `buffer_uri`."""
+    doc = document(**overrides)
+    doc["buffers"] = [{"uri": buffer_uri, "byteLength": byte_length}]
     return doc
 
 
