@@ -2,14 +2,20 @@
 
 use glam::{Vec2, Vec3};
 
+/// Most corners of a concave polygon given to ear clipping. Earcut's z-order hashing keeps
+/// ordinary polygons fast, but thin ears degrade it towards quadratic time (a 200,000-corner
+/// star takes 5–15 s here, found by hostile testing); past this size a concave polygon
+/// becomes a fan, in linear time, and the caller says so.
+pub const MAX_EAR_CLIPPED_CORNERS: usize = 1 << 16;
+
 /// Triangles (as corner positions in `polygon`) covering a planar polygon, each wound like
 /// the polygon: a fan when it is convex, else ear clipping with z-order hashing by the
-/// `earcut` crate (a port of Mapbox's earcut), which stays fast on polygons of hundreds of
-/// thousands of corners where plain ear clipping (Eberly 2002) is quadratic.
-pub fn triangulate(polygon: &[Vec3]) -> Vec<[usize; 3]> {
+/// `earcut` crate (a port of Mapbox's earcut). `None` for a concave polygon of more than
+/// [`MAX_EAR_CLIPPED_CORNERS`] corners, which [`fan`] must cover instead.
+pub fn triangulate(polygon: &[Vec3]) -> Option<Vec<[usize; 3]>> {
     let n = polygon.len();
     if n < 3 {
-        return Vec::new();
+        return Some(Vec::new());
     }
     // Newell's normal: robust for any planar polygon.
     let mut normal = Vec3::ZERO;
@@ -23,7 +29,10 @@ pub fn triangulate(polygon: &[Vec3]) -> Vec<[usize; 3]> {
     }
     let convex_at = |a: Vec3, b: Vec3, c: Vec3| (b - a).cross(c - b).dot(normal) >= 0.0;
     if n == 3 || (0..n).all(|i| convex_at(polygon[i], polygon[(i + 1) % n], polygon[(i + 2) % n])) {
-        return (1..n - 1).map(|i| [0, i, i + 1]).collect();
+        return Some(fan(n));
+    }
+    if n > MAX_EAR_CLIPPED_CORNERS {
+        return None;
     }
     // Project onto the plane across the normal's largest component.
     let axis = normal.abs().max_position();
@@ -40,7 +49,7 @@ pub fn triangulate(polygon: &[Vec3]) -> Vec<[usize; 3]> {
         .collect();
     let mut corners: Vec<u32> = Vec::with_capacity(3 * (n - 2));
     earcut::Earcut::new().earcut(flat, &[] as &[u32], &mut corners);
-    corners
+    let triangles = corners
         .chunks_exact(3)
         .map(|t| {
             let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
@@ -49,7 +58,13 @@ pub fn triangulate(polygon: &[Vec3]) -> Vec<[usize; 3]> {
                 .dot(normal);
             if facing < 0.0 { [a, c, b] } else { [a, b, c] }
         })
-        .collect()
+        .collect();
+    Some(triangles)
+}
+
+/// The fan from corner 0 over an `n`-gon: exact for convex polygons.
+pub fn fan(n: usize) -> Vec<[usize; 3]> {
+    (1..n.saturating_sub(1)).map(|i| [0, i, i + 1]).collect()
 }
 
 #[cfg(test)]
@@ -74,7 +89,7 @@ mod tests {
             Vec3::new(1.0, 1.0, 0.0),
             Vec3::new(0.0, 1.0, 0.0),
         ];
-        assert_eq!(triangulate(&square), vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(triangulate(&square), Some(vec![[0, 1, 2], [0, 2, 3]]));
         // An L shape (area 3) whose fan from corner 0 would cover the notch.
         let l = [
             Vec3::new(1.0, 1.0, 0.0),
@@ -84,36 +99,39 @@ mod tests {
             Vec3::new(0.0, 0.0, 0.0),
             Vec3::new(1.0, 0.0, 0.0),
         ];
-        let tris = triangulate(&l);
+        let tris = triangulate(&l).unwrap();
         assert_eq!(tris.len(), 4);
         assert!((area(&l, &tris) - 3.0).abs() < 1e-6, "{tris:?}");
         // Every triangle keeps the polygon's orientation (positive area).
         assert!(tris.iter().all(|t| area(&l, &[*t]) > 0.0), "{tris:?}");
     }
 
-    #[test]
-    fn a_star_of_two_hundred_thousand_corners_is_covered_quickly() {
-        // Alternating radii make every other corner reflex; the area is known exactly.
-        let n = 200_000;
-        let star: Vec<Vec3> = (0..n)
+    /// A star whose alternating radii make every other corner reflex.
+    fn star(n: usize) -> Vec<Vec3> {
+        (0..n)
             .map(|i| {
-                let angle = std::f32::consts::TAU * i as f32 / n as f32;
+                let angle = std::f64::consts::TAU * i as f64 / n as f64;
                 let r = if i % 2 == 0 { 1.0 } else { 0.9 };
-                Vec3::new(r * angle.cos(), r * angle.sin(), 0.0)
+                Vec3::new((r * angle.cos()) as f32, (r * angle.sin()) as f32, 0.0)
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn large_concave_polygons_are_ear_clipped_up_to_the_limit() {
+        let n = 4096;
+        let star = star(n);
         let expected: f32 = (0..n)
-            .map(|i| {
-                let (a, b) = (star[i], star[(i + 1) % n]);
-                0.5 * a.cross(b).z
-            })
+            .map(|i| 0.5 * star[i].cross(star[(i + 1) % n]).z)
             .sum();
-        let tris = triangulate(&star);
+        let tris = triangulate(&star).unwrap();
         assert_eq!(tris.len(), n - 2);
         let got = area(&star, &tris);
         assert!(
-            (got - expected).abs() < 1e-3 * expected,
+            (got - expected).abs() < 1e-4 * expected,
             "{got} vs {expected}"
         );
+        assert!(triangulate(&self::star(MAX_EAR_CLIPPED_CORNERS + 2)).is_none());
+        assert_eq!(fan(5), vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
     }
 }

@@ -21,7 +21,7 @@ mod resolver;
 
 use resolver::{ConfinedResolver, Refusals};
 
-use super::polygon::triangulate;
+use super::polygon::{MAX_EAR_CLIPPED_CORNERS, fan, triangulate};
 use super::tangents::generate_tangents;
 use super::{AssetRoots, LoadError, LoadOptions, Loaded};
 use crate::record::Dependency;
@@ -603,7 +603,15 @@ impl UsdLoader {
                 .iter()
                 .map(|&c| points[indices[c] as usize])
                 .collect();
-            for [a, b, c] in triangulate(&polygon) {
+            let triangles = triangulate(&polygon).unwrap_or_else(|| {
+                self.warn(format!(
+                    "{where_}: face {face} is a concave polygon of {count} corners, more than \
+                     {MAX_EAR_CLIPPED_CORNERS} are ear-clipped; covered by a fan, which may \
+                     overlap itself"
+                ));
+                fan(polygon.len())
+            });
+            for [a, b, c] in triangles {
                 let tri = [corners[a], corners[b], corners[c]];
                 let tri = if left_handed {
                     [tri[0], tri[2], tri[1]]
