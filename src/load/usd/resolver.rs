@@ -64,14 +64,16 @@ impl Resolver for ConfinedResolver {
             return None;
         }
         // Relative identifiers (no anchor) would be searched for in the working folder.
-        if !Path::new(package_file(asset_path)).is_absolute() {
-            self.refuse(format!(
-                "'{asset_path}' is not anchored to a layer; refused"
-            ));
-            return None;
-        }
+        let anchored = Path::new(package_file(asset_path)).is_absolute();
         match self.check(asset_path) {
-            Ok(()) => self.inner.resolve(asset_path),
+            Ok(()) if anchored => self.inner.resolve(asset_path),
+            Ok(()) if is_layer(asset_path) => {
+                self.refuse(format!(
+                    "'{asset_path}' is not anchored to a layer; refused"
+                ));
+                None
+            }
+            Ok(()) => None,
             // A missing file is the composition's business (an unresolved layer).
             Err(AccessError::Missing { .. }) => None,
             // A refused layer fails the load; a refused texture is the loader's to warn
