@@ -8,6 +8,10 @@ use super::{DEFAULT_DENSITY, Grid, MACRO_SHIFT};
 use crate::accel::Triangle;
 use crate::scene::Aabb;
 
+/// Bounding boxes of at most this many cells are tested cell by cell; larger ones are
+/// walked slab by slab (clipping costs more than it saves on a few cells).
+const SMALL_BOX_CELLS: u64 = 64;
+
 /// Most cells along one axis.
 const MAX_RESOLUTION: u32 = 2048;
 /// Most cells in one grid (the per-cell build counters would otherwise be absurd).
@@ -68,10 +72,13 @@ impl Grid {
         } else {
             let bounds = padded(tight);
             let wanted = resolution(bounds.extent(), live.len(), density);
-            let live_triangles = live.iter().map(|&i| triangles[i as usize].unwrap());
+            let live_triangles: Vec<Triangle> = live
+                .iter()
+                .map(|&i| triangles[i as usize].unwrap())
+                .collect();
             (
                 bounds,
-                within_reference_budget(wanted, bounds, live_triangles),
+                within_reference_budget(wanted, bounds, &live_triangles),
             )
         };
         let cell_size = bounds.extent() / resolution.as_vec3();
@@ -205,6 +212,18 @@ impl Grid {
         }
         let half = 0.5 * self.cell_size + pad;
         let vertices = tri.vertices();
+        // Most triangles span a few cells: test every cell of the bounding box.
+        let span = hi - lo + UVec3::ONE;
+        if span.x as u64 * span.y as u64 * span.z as u64 <= SMALL_BOX_CELLS {
+            for z in lo.z..=hi.z {
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        self.report_if_overlapped(vertices, half, UVec3::new(x, y, z), &mut f);
+                    }
+                }
+            }
+            return;
+        }
         // Walk slab by slab, row by row, clipping the triangle to each, so only cells near
         // it are tested: a long thin triangle across the grid costs its overlap, not the
         // volume of its bounding box (found by hostile testing: a 100k-corner fan took
@@ -230,13 +249,24 @@ impl Grid {
                 let first = self.cell_of(row_bounds.min - pad).x;
                 let last = self.cell_of(row_bounds.max + pad).x;
                 for x in first..=last {
-                    let c = UVec3::new(x, y, z);
-                    let center = self.bounds.min + (c.as_vec3() + 0.5) * self.cell_size;
-                    if triangle_overlaps_box(vertices, center, half) {
-                        f(self.cell_index(c));
-                    }
+                    self.report_if_overlapped(vertices, half, UVec3::new(x, y, z), &mut f);
                 }
             }
+        }
+    }
+
+    /// Calls `f` with cell `c`'s index if the triangle overlaps it (grown by `half`).
+    #[inline]
+    fn report_if_overlapped(
+        &self,
+        vertices: [Vec3; 3],
+        half: Vec3,
+        c: UVec3,
+        f: &mut impl FnMut(usize),
+    ) {
+        let center = self.bounds.min + (c.as_vec3() + 0.5) * self.cell_size;
+        if triangle_overlaps_box(vertices, center, half) {
+            f(self.cell_index(c));
         }
     }
 
@@ -271,28 +301,28 @@ const MAX_REFERENCES: f64 = (1u64 << 31) as f64;
 /// `wanted`, made coarser until the estimated references fit the budget. A triangle of
 /// area A and perimeter P overlaps about √3·A/s² + 2·P/s + 1 cells of side s (the cells its
 /// surface and its edges pass through), and never more than its bounding box holds.
-fn within_reference_budget(
-    wanted: UVec3,
-    bounds: Aabb,
-    triangles: impl Iterator<Item = Triangle> + Clone,
-) -> UVec3 {
-    let count = triangles.clone().count() as f64;
+fn within_reference_budget(wanted: UVec3, bounds: Aabb, triangles: &[Triangle]) -> UVec3 {
+    let count = triangles.len() as f64;
     let budget = (REFERENCES_PER_TRIANGLE * count + (1 << 20) as f64).min(MAX_REFERENCES);
     let mut r = wanted;
     for _ in 0..32 {
         let cell = bounds.extent() / r.as_vec3();
         let s = cell.min_element().max(f32::MIN_POSITIVE) as f64;
-        let estimate: f64 = triangles
-            .clone()
-            .map(|t| {
-                let [a, b, c] = t.vertices();
-                let area = 0.5 * (b - a).cross(c - a).length() as f64;
-                let perimeter = ((b - a).length() + (c - b).length() + (a - c).length()) as f64;
-                let reach = t.bounds().extent() / cell + 1.0;
-                let boxed = reach.x as f64 * reach.y as f64 * reach.z as f64;
-                (3f64.sqrt() * area / (s * s) + 2.0 * perimeter / s + 1.0).min(boxed)
-            })
-            .sum();
+        let estimate_of = |t: &Triangle| {
+            let [a, b, c] = t.vertices();
+            let area = 0.5 * (b - a).cross(c - a).length() as f64;
+            let perimeter = ((b - a).length() + (c - b).length() + (a - c).length()) as f64;
+            let reach = t.bounds().extent() / cell + 1.0;
+            let boxed = reach.x as f64 * reach.y as f64 * reach.z as f64;
+            (3f64.sqrt() * area / (s * s) + 2.0 * perimeter / s + 1.0).min(boxed)
+        };
+        // Partial sums over fixed chunks, added in order: the same total on any number of
+        // threads, so the same grid.
+        let partial: Vec<f64> = triangles
+            .par_chunks(4096)
+            .map(|chunk| chunk.iter().map(estimate_of).sum())
+            .collect();
+        let estimate: f64 = partial.iter().sum();
         if estimate <= budget || r == UVec3::ONE {
             break;
         }
