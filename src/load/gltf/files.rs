@@ -140,7 +140,8 @@ pub(super) fn image_bytes<'a>(
     }
 }
 
-fn is_data_uri(uri: &str) -> bool {
+/// True for a `data:` URI (the scheme is case-insensitive, RFC 3986 §3.1).
+pub(super) fn is_data_uri(uri: &str) -> bool {
     uri.get(..5)
         .is_some_and(|s| s.eq_ignore_ascii_case("data:"))
 }

@@ -2,7 +2,7 @@
 
 use glam::{Affine2, Vec2, Vec3};
 
-use super::files::image_bytes;
+use super::files::{image_bytes, is_data_uri};
 use super::{GltfLoader, MAX_UV_SETS, ROUGHNESS_WARNING, texture_transform};
 use crate::load::images::decode_texture;
 use crate::scene::{AlphaMode, Filter, Material, MaterialKind, MaterialTextures, TextureRef, Wrap};
@@ -204,9 +204,7 @@ impl GltfLoader {
     pub(super) fn warn_about_unreadable_images(&mut self, document: &gltf::Document) {
         for image in document.images() {
             if let gltf::image::Source::Uri { uri, .. } = image.source()
-                && !uri
-                    .get(..5)
-                    .is_some_and(|s| s.eq_ignore_ascii_case("data:"))
+                && !is_data_uri(uri)
                 && let Err(why) = self.files.resolve(uri)
             {
                 self.missing_images.insert(image.index());
