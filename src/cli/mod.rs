@@ -18,6 +18,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::inspect::describe;
 use crate::limits::{check_memory, set_memory_budget};
+use crate::load::access::folder_of;
 use crate::load::{LoadOptions, load_scene_with};
 use crate::merge::merge_files;
 use crate::output::{Format, check_writable, write_image_with_record};
@@ -111,10 +112,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let scene_sha256 =
         sha256_file(scene_path).with_context(|| format!("{}", scene_path.display()))?;
     let loaded = load_scene_with(scene_path, &options)?;
-    let scene_dir = match scene_path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
+    let scene_dir = folder_of(scene_path);
     let dependencies_sha256 =
         sha256_files(scene_dir, &loaded.files).context("hashing the files the scene reads")?;
     for warning in &loaded.warnings {

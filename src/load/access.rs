@@ -85,10 +85,7 @@ impl AssetRoots {
     /// The scene file's folder (as named, and where a symbolic link to the file leads) and
     /// `extra` folders. Folders that do not exist are left out (nothing can be read there).
     pub fn for_scene(scene: &Path, extra: &[PathBuf]) -> AssetRoots {
-        let folder = match scene.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
+        let folder = folder_of(scene).to_path_buf();
         let real_folder = scene
             .canonicalize()
             .ok()
@@ -169,6 +166,14 @@ impl AssetRoots {
             reference: reference.to_string(),
             roots: RootList(self.roots.clone()),
         }
+    }
+}
+
+/// The folder a file lies in, `.` for a bare file name: where its relative paths start.
+pub fn folder_of(file: &Path) -> &Path {
+    match file.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
     }
 }
 

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use crate::limits::check_memory;
 use crate::load::LoadError;
-use crate::load::access::{AccessError, AssetRoots};
+use crate::load::access::{AccessError, AssetRoots, folder_of};
 use crate::record::Dependency;
 
 /// The files of one glTF scene: where relative URIs start, what may be read, and what was.
@@ -25,10 +25,7 @@ pub(super) struct SceneFiles {
 
 impl SceneFiles {
     pub fn new(asker: &Path, roots: AssetRoots) -> SceneFiles {
-        let base = match asker.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
+        let base = folder_of(asker).to_path_buf();
         SceneFiles {
             asker: asker.to_path_buf(),
             base,
