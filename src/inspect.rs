@@ -6,7 +6,8 @@ use std::fmt::Write;
 
 use glam::Vec3;
 
-use crate::scene::{AlphaMode, LightKind, Material, MaterialKind, Projection, Scene};
+use crate::render::Bsdf;
+use crate::scene::{AlphaMode, LightKind, Material, Projection, Scene};
 
 /// The report: meshes, instances, materials with their class, textures, lights with their
 /// power, cameras and every warning.
@@ -88,13 +89,47 @@ fn vector(v: Vec3) -> String {
 }
 
 fn material_summary(m: &Material, emitted: f32) -> String {
-    let mut s = match m.kind {
-        MaterialKind::Diffuse { albedo } => format!("diffuse, albedo {}", vector(albedo)),
-        MaterialKind::Mirror { reflectance } => {
-            format!("mirror, reflectance {}", vector(reflectance))
-        }
-        MaterialKind::Glass { ior, tint } => format!("glass, ior {ior}, tint {}", vector(tint)),
-    };
+    let p = &m.pbr;
+    let lobes = Bsdf::new(p, true).lobe_names();
+    let mut s = format!(
+        "{}; base colour {}, metallic {}, roughness {}, ior {}",
+        if lobes.is_empty() {
+            "black".to_string()
+        } else {
+            lobes.join(" + ")
+        },
+        vector(p.base_colour),
+        significant(p.metallic),
+        significant(p.roughness),
+        significant(p.ior)
+    );
+    if p.specular != 1.0 || p.specular_colour != Vec3::ONE {
+        let _ = write!(
+            s,
+            ", specular {} tint {}",
+            significant(p.specular),
+            vector(p.specular_colour)
+        );
+    }
+    if p.transmission > 0.0 {
+        let _ = write!(s, ", transmission {}", significant(p.transmission));
+    }
+    if p.clearcoat > 0.0 {
+        let _ = write!(
+            s,
+            ", coat {} roughness {}",
+            significant(p.clearcoat),
+            significant(p.clearcoat_roughness)
+        );
+    }
+    if p.sheen_colour != Vec3::ZERO {
+        let _ = write!(
+            s,
+            ", sheen {} roughness {}",
+            vector(p.sheen_colour),
+            significant(p.sheen_roughness)
+        );
+    }
     if m.is_emissive() {
         let _ = write!(
             s,
@@ -110,7 +145,11 @@ fn material_summary(m: &Material, emitted: f32) -> String {
     let textures: Vec<&str> = [
         (t.base_colour.is_some(), "base colour"),
         (t.emissive.is_some(), "emission"),
-        (t.metallic_roughness.is_some(), "metallic"),
+        (t.metallic.is_some(), "metallic"),
+        (t.roughness.is_some(), "roughness"),
+        (t.transmission.is_some(), "transmission"),
+        (t.clearcoat.is_some(), "coat"),
+        (t.clearcoat_roughness.is_some(), "coat roughness"),
         (t.normal.is_some(), "normal map"),
     ]
     .into_iter()

@@ -9,7 +9,7 @@ use gridtrace::accel::Ray;
 use gridtrace::render::sampling::Rng;
 use gridtrace::render::{RenderSettings, Renderer, Strategy};
 use gridtrace::scene::{
-    AlphaMode, Light, LightKind, Material, MaterialKind, Scene, SceneBuilder, Texture, TextureRef,
+    AlphaMode, Light, LightKind, Material, Pbr, Scene, SceneBuilder, Texture, TextureRef,
 };
 use shapes::{add_box_inside, add_box_outside, add_quad, add_sphere, camera_at};
 
@@ -291,16 +291,14 @@ fn add_backdrop(b: &mut SceneBuilder, z: f32, radiance: Vec3) {
     );
 }
 
-/// An ideal mirror of reflectance ρ shows a uniform emitter at exactly ρ·L.
+/// A smooth conductor of F0 = ρ shows a uniform emitter at exactly F·L, with Schlick's
+/// F = ρ + (1 − ρ)(1 − cos θ)⁵ at the 45° the camera ray meets it.
 #[test]
 fn mirror_reflects_its_reflectance_times_the_radiance() {
     let (reflectance, radiance) = (Vec3::new(0.9, 0.5, 0.2), Vec3::new(1.0, 2.0, 3.0));
     let mut b = SceneBuilder::new();
     add_backdrop(&mut b, -3.0, radiance);
-    let mirror = b.add_material(Material::new(
-        "mirror",
-        MaterialKind::Mirror { reflectance },
-    ));
+    let mirror = b.add_material(Material::new("mirror", Pbr::mirror(reflectance)));
     // A mirror in the plane x = z, facing (1, 0, 1)/√2: rays along −X turn to −Z.
     let v = Vec3::new;
     add_quad(
@@ -315,7 +313,9 @@ fn mirror_reflects_its_reflectance_times_the_radiance() {
     );
     let scene = b.build();
     let ray = Ray::new(v(5.0, 0.1, 0.0), v(-1.0, 0.0, 0.0));
-    let expected = (reflectance * radiance).as_dvec3();
+    let schlick = (1.0 - std::f32::consts::FRAC_1_SQRT_2).powi(5);
+    let fresnel = reflectance + (Vec3::ONE - reflectance) * schlick;
+    let expected = (fresnel * radiance).as_dvec3();
     for strategy in STRATEGIES {
         let (mean, _) = estimate(&scene, ray, strategy, 16);
         assert!(
@@ -335,10 +335,7 @@ fn glass_slab_transmits_the_fresnel_series() {
     for tint in [Vec3::ONE, Vec3::new(0.9, 0.7, 0.4)] {
         let mut b = SceneBuilder::new();
         add_backdrop(&mut b, -5.0, radiance);
-        let glass = b.add_material(Material::new(
-            "glass",
-            MaterialKind::Glass { ior: eta, tint },
-        ));
+        let glass = b.add_material(Material::new("glass", Pbr::glass(eta, tint)));
         // A 40 × 40 × 0.5 slab: the box [-1, 1]³ wound outwards, squashed in z.
         add_box_outside(
             &mut b,
@@ -373,39 +370,16 @@ fn glass_slab_transmits_the_fresnel_series() {
 #[test]
 fn objects_in_radiative_equilibrium_are_invisible() {
     let equilibrium = 1.0f32;
-    let emitting = |name: &str, kind: MaterialKind, reflectance: f32| Material {
+    let emitting = |name: &str, pbr: Pbr, reflectance: f32| Material {
         emission: Vec3::splat((1.0 - reflectance) * equilibrium),
-        ..Material::new(name, kind)
+        ..Material::new(name, pbr)
     };
     let mut b = SceneBuilder::new();
-    let walls = b.add_material(emitting(
-        "walls",
-        MaterialKind::Diffuse {
-            albedo: Vec3::splat(0.5),
-        },
-        0.5,
-    ));
-    let diffuse = b.add_material(emitting(
-        "diffuse",
-        MaterialKind::Diffuse {
-            albedo: Vec3::splat(0.9),
-        },
-        0.9,
-    ));
-    let mirror = b.add_material(emitting(
-        "mirror",
-        MaterialKind::Mirror {
-            reflectance: Vec3::splat(0.8),
-        },
-        0.8,
-    ));
-    let glass = b.add_material(Material::new(
-        "glass",
-        MaterialKind::Glass {
-            ior: 1.5,
-            tint: Vec3::ONE,
-        },
-    ));
+    let walls = b.add_material(emitting("walls", Pbr::diffuse(Vec3::splat(0.5)), 0.5));
+    let diffuse = b.add_material(emitting("diffuse", Pbr::diffuse(Vec3::splat(0.9)), 0.9));
+    // A white conductor reflects everything at every angle, so it emits nothing.
+    let mirror = b.add_material(emitting("mirror", Pbr::mirror(Vec3::ONE), 1.0));
+    let glass = b.add_material(Material::new("glass", Pbr::glass(1.5, Vec3::ONE)));
     add_box_inside(&mut b, walls);
     add_sphere(&mut b, Vec3::new(-0.45, -0.4, -0.4), 0.35, diffuse);
     add_sphere(&mut b, Vec3::new(0.45, -0.4, -0.4), 0.35, mirror);
@@ -502,13 +476,7 @@ fn absorbing_glass_slab_follows_beer_lambert() {
     add_backdrop(&mut b, -5.0, radiance);
     let glass = b.add_material(Material {
         absorption: sigma,
-        ..Material::new(
-            "glass",
-            MaterialKind::Glass {
-                ior: eta,
-                tint: Vec3::ONE,
-            },
-        )
+        ..Material::new("glass", Pbr::glass(eta, Vec3::ONE))
     });
     add_box_outside(
         &mut b,

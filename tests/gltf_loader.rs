@@ -6,7 +6,7 @@ use common::{quad_document, write_gltf};
 use glam::{Affine3A, Quat, Vec3};
 use gridtrace::cli::choose_camera;
 use gridtrace::load::{GltfLightUnits, LoadError, LoadOptions, load_scene, load_scene_with};
-use gridtrace::scene::{LightKind, MaterialKind, Projection};
+use gridtrace::scene::{LightKind, Pbr, Projection};
 use serde_json::json;
 
 fn approx(a: Vec3, b: Vec3) -> bool {
@@ -173,7 +173,8 @@ fn materials_map_by_the_table() {
         {"name": "half metal", "pbrMetallicRoughness": {"metallicFactor": 0.49}},
         {"name": "plastic", "pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.2, 0.3, 1.0], "metallicFactor": 0.0},
          "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.49}}},
-        {"name": "glass default ior", "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}}},
+        {"name": "glass default ior", "pbrMetallicRoughness": {"metallicFactor": 0.0},
+         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}}},
         {"name": "one-sided", "doubleSided": false, "pbrMetallicRoughness": {"metallicFactor": 0.0}}
     ]);
     let prim = |m: Option<usize>| match m {
@@ -183,65 +184,36 @@ fn materials_map_by_the_table() {
     doc["meshes"] =
         json!([{"primitives": (0..7).map(Some).chain([None]).map(prim).collect::<Vec<_>>()}]);
     let loaded = load_scene(&write_gltf(dir.path(), "m.gltf", &doc)).unwrap();
-    // glTF's default roughness is 1: each rough mirror or glass is named once.
-    assert_eq!(loaded.warnings.len(), 3, "{:?}", loaded.warnings);
-    for (warning, name) in loaded
-        .warnings
-        .iter()
-        .zip(["'glass'", "'metal'", "'glass default ior'"])
-    {
-        assert!(
-            warning.contains(name)
-                && warning.contains("roughness 1 is rendered as perfectly smooth"),
-            "{warning}"
-        );
-    }
-    let m = &loaded.scene.materials;
-    assert_eq!(m[0].emission, Vec3::new(4.0, 2.0, 1.0));
-    assert!(matches!(m[0].kind, MaterialKind::Diffuse { albedo } if albedo == Vec3::ONE));
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let m: Vec<Pbr> = loaded.scene.materials.iter().map(|m| m.pbr).collect();
+    let materials = &loaded.scene.materials;
+    assert_eq!(materials[0].emission, Vec3::new(4.0, 2.0, 1.0));
+    // glTF's defaults: white, roughness 1, the full specular layer of IOR 1.5.
     assert_eq!(
-        m[1].kind,
-        MaterialKind::Glass {
-            ior: 1.33,
-            tint: Vec3::new(0.9, 1.0, 0.9)
+        m[0],
+        Pbr {
+            metallic: 0.0,
+            ..Pbr::default()
         }
     );
-    assert_eq!(m[1].emission, Vec3::ZERO);
+    // Metallic and transmission blend continuously; transmission only affects the dielectric.
+    assert!(m[1].metallic == 1.0 && m[1].transmission == 0.5 && m[1].ior == 1.33);
+    assert_eq!(m[1].base_colour, Vec3::new(0.9, 1.0, 0.9));
     // glTF's default metallicFactor is 1.
-    assert_eq!(
-        m[2].kind,
-        MaterialKind::Mirror {
-            reflectance: Vec3::new(0.9, 0.6, 0.2)
-        }
-    );
-    assert_eq!(m[3].kind, MaterialKind::Diffuse { albedo: Vec3::ONE });
-    assert_eq!(
-        m[4].kind,
-        MaterialKind::Diffuse {
-            albedo: Vec3::new(0.1, 0.2, 0.3)
-        }
-    );
-    assert_eq!(
-        m[5].kind,
-        MaterialKind::Glass {
-            ior: 1.5,
-            tint: Vec3::ONE
-        }
-    );
-    // glTF's default is single-sided; Blender writes doubleSided: true. Glass is always
-    // two-sided: its back faces are the inside of the volume.
-    assert!(!m[6].double_sided && !m[3].double_sided);
-    assert!(m[5].double_sided);
-    // A primitive without a material gets a grey diffuse one.
+    assert!(m[2].metallic == 1.0 && m[2].base_colour == Vec3::new(0.9, 0.6, 0.2));
+    assert_eq!(m[3].metallic, 0.49);
+    assert!(m[4].transmission == 0.49 && m[4].base_colour == Vec3::new(0.1, 0.2, 0.3));
+    assert!(m[5].transmission == 1.0 && m[5].ior == 1.5 && m[5].metallic == 0.0);
+    // glTF's default is single-sided; Blender writes doubleSided: true. A transmitting
+    // material is always two-sided: its back faces are the inside of the volume.
+    assert!(!materials[6].double_sided && !materials[3].double_sided);
+    assert!(materials[5].double_sided);
+    // A primitive without a material gets grey plastic.
     let scene = &loaded.scene;
     assert_eq!(scene.meshes.len(), 8);
-    let default = &m[scene.meshes[7].material];
-    assert_eq!(
-        default.kind,
-        MaterialKind::Diffuse {
-            albedo: Vec3::splat(0.8)
-        }
-    );
+    let default = &materials[scene.meshes[7].material];
+    assert_eq!(default.pbr.base_colour, Vec3::splat(0.8));
+    assert!(default.pbr.metallic == 0.0 && default.pbr.roughness == 0.5);
     assert!(scene.has_emitters());
 }
 
@@ -365,9 +337,7 @@ fn the_bundled_cornell_box_loads_as_blender_wrote_it() {
     // Blender: colour (1, 0.85, 0.6) at strength 12, through KHR_materials_emissive_strength.
     assert!(approx(light.emission, Vec3::new(12.0, 10.2, 7.2)));
     let red = scene.materials.iter().find(|m| m.name == "Red").unwrap();
-    assert!(
-        matches!(red.kind, MaterialKind::Diffuse { albedo } if approx(albedo, Vec3::new(0.63, 0.065, 0.05)))
-    );
+    assert!(approx(red.pbr.base_colour, Vec3::new(0.63, 0.065, 0.05)) && red.pbr.metallic == 0.0);
     // Blender's Z-up box arrives Y-up: the floor at y = 0, the ceiling at y = 2.
     let b = scene.bounds();
     assert!(
@@ -381,19 +351,18 @@ fn the_bundled_cornell_box_loads_as_blender_wrote_it() {
     let kinds: Vec<_> = spheres
         .materials
         .iter()
-        .map(|m| (m.name.as_str(), m.kind))
+        .map(|m| (m.name.as_str(), m.pbr))
         .collect();
     assert!(
         kinds
             .iter()
-            .any(|(n, k)| *n == "Mirror" && matches!(k, MaterialKind::Mirror { .. })),
+            .any(|(n, p)| *n == "Mirror" && p.metallic == 1.0 && p.roughness == 0.0),
         "{kinds:?}"
     );
     assert!(
         kinds
             .iter()
-            .any(|(n, k)| *n == "Glass"
-                && matches!(k, MaterialKind::Glass { ior, .. } if *ior == 1.5)),
+            .any(|(n, p)| *n == "Glass" && p.transmission == 1.0 && p.ior == 1.5),
         "{kinds:?}"
     );
 }

@@ -6,11 +6,23 @@ mod shapes;
 use glam::{Affine3A, Vec3};
 use gridtrace::load::load_scene;
 use gridtrace::render::{Image, RenderSettings, Renderer, Strategy};
-use gridtrace::scene::{Camera, Material, MaterialKind, Scene, SceneBuilder};
+use gridtrace::scene::{Camera, Material, Pbr, Scene, SceneBuilder};
 use shapes::{add_box_inside, add_quad, add_sphere, camera_at};
 
-/// An open-fronted diffuse box with a small ceiling light, a mirror and a glass sphere.
-fn test_room(with_specular: bool) -> Scene {
+/// What stands in the test room besides its diffuse walls.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Contents {
+    /// Nothing.
+    Empty,
+    /// An ideal mirror and an ideal glass sphere (delta lobes only).
+    Ideal,
+    /// Glossy surfaces: a rough gold panel, a coated plastic sphere with sheen, rough glass,
+    /// so every non-delta lobe meets light sampling and MIS.
+    Glossy,
+}
+
+/// An open-fronted diffuse box with a small ceiling light and `contents`.
+fn test_room(contents: Contents) -> Scene {
     let mut b = SceneBuilder::new();
     let white = b.add_material(Material::diffuse("white", Vec3::splat(0.7)));
     let red = b.add_material(Material::diffuse("red", Vec3::new(0.7, 0.1, 0.1)));
@@ -82,18 +94,20 @@ fn test_room(with_specular: bool) -> Scene {
         ],
         light,
     );
-    if with_specular {
+    if contents != Contents::Empty {
+        let glossy = contents == Contents::Glossy;
         let mirror = b.add_material(Material::new(
             "mirror",
-            MaterialKind::Mirror {
-                reflectance: Vec3::splat(0.9),
+            Pbr {
+                roughness: if glossy { 0.4 } else { 0.0 },
+                ..Pbr::mirror(Vec3::new(1.0, 0.78, 0.34))
             },
         ));
         let glass = b.add_material(Material::new(
             "glass",
-            MaterialKind::Glass {
-                ior: 1.5,
-                tint: Vec3::ONE,
+            Pbr {
+                roughness: if glossy { 0.3 } else { 0.0 },
+                ..Pbr::glass(1.5, Vec3::ONE)
             },
         ));
         add_quad(
@@ -107,6 +121,22 @@ fn test_room(with_specular: bool) -> Scene {
             mirror,
         );
         add_sphere(&mut b, v(0.4, -0.6, 0.1), 0.35, glass);
+        if glossy {
+            let plastic = b.add_material(Material::new(
+                "coated plastic",
+                Pbr {
+                    base_colour: Vec3::new(0.2, 0.4, 0.8),
+                    metallic: 0.0,
+                    roughness: 0.25,
+                    clearcoat: 0.8,
+                    clearcoat_roughness: 0.1,
+                    sheen_colour: Vec3::new(0.5, 0.4, 0.3),
+                    sheen_roughness: 0.4,
+                    ..Pbr::default()
+                },
+            ));
+            add_sphere(&mut b, v(-0.45, -0.7, 0.45), 0.3, plastic);
+        }
     }
     b.build()
 }
@@ -199,18 +229,14 @@ fn assert_agree(name: &str, a: &(Vec<f64>, Vec<f64>), b: &(Vec<f64>, Vec<f64>)) 
 
 #[test]
 fn light_sampling_bsdf_sampling_and_mis_converge_to_the_same_image() {
-    for with_specular in [false, true] {
-        let scene = test_room(with_specular);
+    for contents in [Contents::Empty, Contents::Ideal, Contents::Glossy] {
+        let scene = test_room(contents);
         let camera = camera_at(3.4, 40.0);
         let mis = estimate(&scene, &camera, Strategy::Mis, SEEDS, 32, 16);
         let light = estimate(&scene, &camera, Strategy::LightOnly, SEEDS, 32, 16);
         let bsdf = estimate(&scene, &camera, Strategy::BsdfOnly, SEEDS, 32, 16);
         assert!(mis.0.iter().all(|&m| m > 0.0), "every block receives light");
-        let name = if with_specular {
-            "with mirror and glass"
-        } else {
-            "diffuse"
-        };
+        let name = format!("{contents:?}");
         assert_agree(&format!("{name}: MIS vs light sampling"), &mis, &light);
         assert_agree(&format!("{name}: MIS vs BSDF sampling"), &mis, &bsdf);
         assert_agree(&format!("{name}: light vs BSDF sampling"), &light, &bsdf);
@@ -364,7 +390,7 @@ fn images_do_not_depend_on_the_scene_scale() {
         );
     }
     let reference = estimate(
-        &test_room(true),
+        &test_room(Contents::Ideal),
         &camera_at(3.4, 40.0),
         Strategy::Mis,
         SEEDS,
@@ -377,7 +403,7 @@ fn images_do_not_depend_on_the_scene_scale() {
             ..camera_at(0.0, 40.0)
         };
         let at_scale = estimate(
-            &scaled(test_room(true), s),
+            &scaled(test_room(Contents::Ideal), s),
             &camera,
             Strategy::Mis,
             SEEDS,

@@ -8,7 +8,7 @@ use std::path::Path;
 use glam::Vec3;
 use gridtrace::cli::choose_camera;
 use gridtrace::load::{LoadError, LoadOptions, load_scene, load_scene_with};
-use gridtrace::scene::{Filter, LightKind, MaterialKind, Projection, Scene};
+use gridtrace::scene::{Filter, LightKind, Projection, Scene};
 use image_stats::{check_agreement, render_halves, render_scene_halves};
 
 /// Blender's Cornell box through its USD exporter (Z-up, metres, UsdPreviewSurface) and
@@ -451,23 +451,13 @@ fn a_hand_written_stage_loads_as_usd_defines_it() {
             .unwrap_or_else(|| panic!("{name}"))
             .clone()
     };
-    assert_eq!(
-        kind("/World/Looks/Red").kind,
-        MaterialKind::Diffuse {
-            albedo: Vec3::new(0.8, 0.1, 0.1)
-        }
-    );
-    assert!(matches!(
-        kind("/World/Looks/Mirror").kind,
-        MaterialKind::Mirror { .. }
-    ));
-    assert_eq!(
-        kind("/World/Looks/Glass").kind,
-        MaterialKind::Glass {
-            ior: 1.33,
-            tint: Vec3::ONE
-        }
-    );
+    let red = kind("/World/Looks/Red").pbr;
+    assert_eq!(red.base_colour, Vec3::new(0.8, 0.1, 0.1));
+    assert!(red.metallic == 0.0 && red.transmission == 0.0 && red.specular == 1.0);
+    assert_eq!(kind("/World/Looks/Mirror").pbr.metallic, 1.0);
+    let glass = kind("/World/Looks/Glass").pbr;
+    // UsdPreviewSurface refracts with its ior below full opacity: opacity 0.1 transmits 0.9.
+    assert!((glass.transmission - 0.9).abs() < 1e-6 && glass.ior == 1.33);
     assert_eq!(kind("/World/Looks/Emit").emission, Vec3::new(5.0, 4.0, 3.0));
 
     // Camera: 50 mm over a 24 mm aperture, near plane 10 cm.

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 use crate::accel::Triangle;
 use crate::record::Dependency;
-use crate::scene::{MaterialKind, Scene};
+use crate::scene::Scene;
 
 /// A loaded scene and the warnings met on the way (things skipped or approximated).
 #[derive(Debug)]
@@ -69,9 +69,8 @@ pub fn load_scene(path: &Path) -> Result<Loaded, LoadError> {
 pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError> {
     let mut loaded = load_by_format(path, options)?;
     for material in &loaded.scene.materials {
-        if let MaterialKind::Glass { ior, .. } = material.kind
-            && !(ior.is_finite() && ior > 0.0)
-        {
+        let ior = material.pbr.ior;
+        if material.pbr.transmits() && !(ior.is_finite() && ior > 0.0) {
             return Err(LoadError::Invalid {
                 path: path.to_path_buf(),
                 what: format!(

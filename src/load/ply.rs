@@ -14,9 +14,6 @@ use super::{LoadError, Loaded};
 use crate::limits::check_memory;
 use crate::scene::{Material, Mesh, SceneBuilder};
 
-/// Albedo of the material given to PLY meshes.
-const PLY_ALBEDO: f32 = 0.8;
-
 /// A vertex position; other vertex properties are ignored.
 #[derive(Default)]
 struct PlyVertex(Vec3);
@@ -244,7 +241,7 @@ fn check_declared_sizes(header: &ply_rs_bw::ply::Header, budget: u64) -> Result<
 pub fn load(path: &Path) -> Result<Loaded, LoadError> {
     let (positions, indices) = read_mesh(path)?;
     let mut builder = SceneBuilder::new();
-    let material = builder.add_material(Material::diffuse("ply", Vec3::splat(PLY_ALBEDO)));
+    let material = builder.add_material(Material::default_grey("ply"));
     let normals = Mesh::compute_vertex_normals(&positions, &indices);
     let name = path
         .file_name()

@@ -115,7 +115,7 @@ impl Renderer<'_> {
             let cos_o = s.geometric_normal.dot(wo);
             let front = cos_o > 0.0;
             let material = &self.scene.materials[s.material];
-            let shading = self.shade(&s);
+            let shading = self.shade(&s, front);
 
             // Emission reached by the previous bounce.
             if material.is_emissive() && (front || material.double_sided) {
@@ -156,7 +156,7 @@ impl Renderer<'_> {
             }
 
             // Sample the BSDF to extend the path.
-            let Some(sample) = bsdf.sample(ns, wo, front, rng.uniform2(), rng.uniform()) else {
+            let Some(sample) = bsdf.sample(ns, wo, rng.uniform2(), rng.uniform()) else {
                 break;
             };
             let side = sample.wi.dot(ng);
@@ -224,7 +224,9 @@ impl Renderer<'_> {
         let Some(ls) = sample else {
             return Vec3::ZERO;
         };
-        if ls.radiance == Vec3::ZERO || ng.dot(ls.wi) <= 0.0 {
+        // A light seen through the surface counts only for lobes that transmit; the
+        // geometric and shading normals must agree on which side it is.
+        if ls.radiance == Vec3::ZERO || (ng.dot(ls.wi) > 0.0) != (ns.dot(ls.wi) > 0.0) {
             return Vec3::ZERO;
         }
         let f = bsdf.eval(ns, wo, ls.wi) * ns.dot(ls.wi).abs();

@@ -134,6 +134,11 @@ impl Frame {
     pub fn to_world(&self, v: Vec3) -> Vec3 {
         v.x * self.s + v.y * self.t + v.z * self.n
     }
+
+    /// A world direction expressed in the frame (normal = +Z).
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
 }
 
 /// A discrete distribution proportional to non-negative weights, sampled by inverting its CDF.

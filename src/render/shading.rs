@@ -8,7 +8,7 @@ use super::Renderer;
 use super::bsdf::Bsdf;
 use super::sampling::Rng;
 use super::surface::Surface;
-use crate::scene::{AlphaMode, ColorSpace, Material, MaterialKind, Mesh, Scene, TextureRef};
+use crate::scene::{AlphaMode, ChannelRef, ColorSpace, Material, Mesh, Scene, TextureRef};
 
 /// A material evaluated at a point.
 #[derive(Clone, Copy, Debug)]
@@ -52,12 +52,12 @@ pub fn texture_at(
 }
 
 impl Renderer<'_> {
-    /// The material of `s` evaluated there.
-    pub(super) fn shade(&self, s: &Surface) -> Shading {
+    /// The material of `s` evaluated there, for a ray arriving on the `front` side.
+    pub(super) fn shade(&self, s: &Surface, front: bool) -> Shading {
         let material = &self.scene.materials[s.material];
         if !material.varies() {
             return Shading {
-                bsdf: Bsdf(material.kind),
+                bsdf: Bsdf::new(&material.pbr, front),
                 emission: material.emission,
                 normal: s.shading_normal,
             };
@@ -66,39 +66,37 @@ impl Renderer<'_> {
         let lookup = |r: &TextureRef, space| {
             texture_at(self.scene, mesh, r, s.vertices, s.barycentrics, space)
         };
-        let mut colour = material.kind.colour();
-        if let Some(r) = &material.textures.base_colour {
-            colour *= lookup(r, ColorSpace::Srgb).truncate();
+        let channel = |c: &Option<ChannelRef>| {
+            c.as_ref().map_or(1.0, |c| {
+                lookup(&c.texture, ColorSpace::Linear)[c.channel.min(3)]
+            })
+        };
+        let textures = &material.textures;
+        let mut pbr = material.pbr;
+        if let Some(r) = &textures.base_colour {
+            pbr.base_colour *= lookup(r, ColorSpace::Srgb).truncate();
         }
         if material.vertex_colours {
-            colour *= self.vertex_colour(mesh, s).truncate();
+            pbr.base_colour *= self.vertex_colour(mesh, s).truncate();
         }
-        let mut kind = material.kind.with_colour(colour);
-        if let Some(r) = &material.textures.metallic_roughness
-            && !matches!(kind, MaterialKind::Glass { .. })
-        {
-            let metallic = material.textures.metallic_factor * lookup(r, ColorSpace::Linear).z;
-            kind = if metallic >= 0.5 {
-                MaterialKind::Mirror {
-                    reflectance: colour,
-                }
-            } else {
-                MaterialKind::Diffuse { albedo: colour }
-            };
-        }
+        pbr.metallic *= channel(&textures.metallic);
+        pbr.roughness *= channel(&textures.roughness);
+        pbr.transmission *= channel(&textures.transmission);
+        pbr.clearcoat *= channel(&textures.clearcoat);
+        pbr.clearcoat_roughness *= channel(&textures.clearcoat_roughness);
         let mut emission = material.emission;
-        if let Some(r) = &material.textures.emissive {
+        if let Some(r) = &textures.emissive {
             emission *= lookup(r, ColorSpace::Srgb).truncate();
         }
-        let normal = match &material.textures.normal {
+        let normal = match &textures.normal {
             Some(r) if !mesh.tangents.is_empty() => {
                 let texel = lookup(r, ColorSpace::Linear);
-                self.normal_mapped(s, mesh, texel, material.textures.normal_scale)
+                self.normal_mapped(s, mesh, texel, textures.normal_scale)
             }
             _ => s.shading_normal,
         };
         Shading {
-            bsdf: Bsdf(kind),
+            bsdf: Bsdf::new(&pbr, front),
             emission,
             normal,
         }

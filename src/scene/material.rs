@@ -1,51 +1,108 @@
-//! Materials: the four surface models gridtrace renders, plus emission.
+//! Materials: one physically based surface description, plus emission, alpha and textures.
 
 use glam::Vec3;
 
 use super::TextureRef;
 
-/// How a surface scatters light.
+/// How a surface scatters light: the glTF 2.0 metallic-roughness model with its KHR material
+/// extensions (glTF 2.0 Appendix B; `KHR_materials_{ior,specular,transmission,clearcoat,sheen}`),
+/// which is also what Blender's Principled BSDF and USD's `UsdPreviewSurface` describe. Loaders
+/// fill it; [`crate::render::Bsdf::new`] is the one place that turns it into lobes.
+///
+/// Roughness is perceptual (GGX α = roughness²). Zero roughness gives exact delta lobes, so
+/// the ideal models are special cases: [`Pbr::diffuse`], [`Pbr::mirror`], [`Pbr::glass`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum MaterialKind {
-    /// Lambertian reflection, f = albedo/π.
-    Diffuse {
-        /// Reflectance in [0, 1] per channel.
-        albedo: Vec3,
-    },
-    /// Ideal specular reflection.
-    Mirror {
-        /// Reflectance per channel.
-        reflectance: Vec3,
-    },
-    /// Ideal smooth dielectric: Fresnel-weighted reflection and refraction.
-    Glass {
-        /// Relative index of refraction inside / outside.
-        ior: f32,
-        /// Transmission colour.
-        tint: Vec3,
-    },
+pub struct Pbr {
+    /// Diffuse albedo of dielectrics, F0 of metals, transmission tint of glass.
+    pub base_colour: Vec3,
+    /// 0: dielectric, 1: conductor; blends linearly in between.
+    pub metallic: f32,
+    /// Perceptual roughness of the specular, metal and transmission lobes.
+    pub roughness: f32,
+    /// Index of refraction of the dielectric (1.5 by default).
+    pub ior: f32,
+    /// Strength of the dielectric specular layer (`KHR_materials_specular`'s
+    /// `specularFactor`; 0 leaves a pure Lambertian base). Also its reflectance at grazing
+    /// angles.
+    pub specular: f32,
+    /// Tint of the dielectric layer's F0 (`specularColorFactor`).
+    pub specular_colour: Vec3,
+    /// Fraction of the dielectric that transmits instead of being diffuse.
+    pub transmission: f32,
+    /// Weight of a clear dielectric coat (IOR 1.5) over everything.
+    pub clearcoat: f32,
+    /// Perceptual roughness of the coat.
+    pub clearcoat_roughness: f32,
+    /// Colour of the sheen layer (zero: no sheen).
+    pub sheen_colour: Vec3,
+    /// Perceptual roughness of the sheen (Charlie distribution).
+    pub sheen_roughness: f32,
 }
 
-impl MaterialKind {
-    /// The colour the model is tinted by: albedo, reflectance or transmission tint.
-    pub fn colour(&self) -> Vec3 {
-        match *self {
-            MaterialKind::Diffuse { albedo } => albedo,
-            MaterialKind::Mirror { reflectance } => reflectance,
-            MaterialKind::Glass { tint, .. } => tint,
+impl Default for Pbr {
+    /// glTF's defaults: white, metallic 1 and roughness 1 as `pbrMetallicRoughness` says,
+    /// IOR 1.5 with the full specular layer, no transmission, coat or sheen.
+    fn default() -> Pbr {
+        Pbr {
+            base_colour: Vec3::ONE,
+            metallic: 1.0,
+            roughness: 1.0,
+            ior: 1.5,
+            specular: 1.0,
+            specular_colour: Vec3::ONE,
+            transmission: 0.0,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            sheen_colour: Vec3::ZERO,
+            sheen_roughness: 0.0,
+        }
+    }
+}
+
+impl Pbr {
+    /// A pure Lambertian reflector, f = albedo/π: no specular layer.
+    pub fn diffuse(albedo: Vec3) -> Pbr {
+        Pbr {
+            base_colour: albedo,
+            metallic: 0.0,
+            specular: 0.0,
+            ..Pbr::default()
         }
     }
 
-    /// The same model with its colour replaced.
-    pub fn with_colour(self, colour: Vec3) -> MaterialKind {
-        match self {
-            MaterialKind::Diffuse { .. } => MaterialKind::Diffuse { albedo: colour },
-            MaterialKind::Mirror { .. } => MaterialKind::Mirror {
-                reflectance: colour,
-            },
-            MaterialKind::Glass { ior, .. } => MaterialKind::Glass { ior, tint: colour },
+    /// A smooth conductor with F0 = `reflectance` (Schlick's Fresnel towards white).
+    pub fn mirror(reflectance: Vec3) -> Pbr {
+        Pbr {
+            base_colour: reflectance,
+            metallic: 1.0,
+            roughness: 0.0,
+            ..Pbr::default()
         }
     }
+
+    /// A smooth dielectric that reflects by Fresnel's equations and transmits the rest,
+    /// tinted by `tint`.
+    pub fn glass(ior: f32, tint: Vec3) -> Pbr {
+        Pbr {
+            base_colour: tint,
+            metallic: 0.0,
+            roughness: 0.0,
+            ior,
+            transmission: 1.0,
+            ..Pbr::default()
+        }
+    }
+
+    /// True when light can pass through the surface (into a volume behind it).
+    pub fn transmits(&self) -> bool {
+        self.transmission > 0.0 && self.metallic < 1.0
+    }
+}
+
+/// Normal-incidence reflectance of a dielectric of index `ior` in air, ((η − 1)/(η + 1))²
+/// (Fresnel's equations at θ = 0).
+pub fn f0_of_ior(ior: f32) -> f32 {
+    ((ior - 1.0) / (ior + 1.0)).powi(2)
 }
 
 /// How a material's alpha (base alpha × texture alpha × vertex alpha) hides the surface.
@@ -64,19 +121,35 @@ pub enum AlphaMode {
     Blend,
 }
 
-/// What textures and vertex attributes change over a material's surface (glTF's
-/// metallic-roughness model). All `None`: the material is uniform.
+/// One channel of a texture, for a scalar input (glTF packs metallic in blue and roughness
+/// in green of one texture; USD connects each input to an output `r`, `g`, `b` or `a`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChannelRef {
+    /// The texture.
+    pub texture: TextureRef,
+    /// 0 = red … 3 = alpha.
+    pub channel: usize,
+}
+
+/// What textures and vertex attributes change over a material's surface. Each texture
+/// multiplies the matching [`Pbr`] factor, as glTF defines. All `None`: the material is
+/// uniform.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct MaterialTextures {
-    /// sRGB colour and linear alpha multiplying the model's colour and `alpha`.
+    /// sRGB colour and linear alpha multiplying the base colour and `alpha`.
     pub base_colour: Option<TextureRef>,
     /// sRGB colour multiplying `emission`.
     pub emissive: Option<TextureRef>,
-    /// Linear; blue = metallic (× `metallic_factor`): where the product reaches 0.5 the
-    /// surface is a mirror, elsewhere diffuse. Glass stays glass.
-    pub metallic_roughness: Option<TextureRef>,
-    /// The glTF `metallicFactor`, which the metallic texture multiplies.
-    pub metallic_factor: f32,
+    /// Linear, multiplies [`Pbr::metallic`].
+    pub metallic: Option<ChannelRef>,
+    /// Linear, multiplies [`Pbr::roughness`].
+    pub roughness: Option<ChannelRef>,
+    /// Linear, multiplies [`Pbr::transmission`].
+    pub transmission: Option<ChannelRef>,
+    /// Linear, multiplies [`Pbr::clearcoat`].
+    pub clearcoat: Option<ChannelRef>,
+    /// Linear, multiplies [`Pbr::clearcoat_roughness`].
+    pub clearcoat_roughness: Option<ChannelRef>,
     /// Tangent-space normal map (linear, +Y up, OpenGL convention as glTF defines).
     pub normal: Option<TextureRef>,
     /// Scales the normal map's X and Y.
@@ -88,7 +161,11 @@ impl MaterialTextures {
     pub fn any(&self) -> bool {
         self.base_colour.is_some()
             || self.emissive.is_some()
-            || self.metallic_roughness.is_some()
+            || self.metallic.is_some()
+            || self.roughness.is_some()
+            || self.transmission.is_some()
+            || self.clearcoat.is_some()
+            || self.clearcoat_roughness.is_some()
             || self.normal.is_some()
     }
 }
@@ -99,7 +176,7 @@ pub struct Material {
     /// Name for messages.
     pub name: String,
     /// The scattering model.
-    pub kind: MaterialKind,
+    pub pbr: Pbr,
     /// Emitted radiance (W·sr⁻¹·m⁻²); zero for non-emitters.
     pub emission: Vec3,
     /// When false, the back face neither emits nor scatters light (it absorbs).
@@ -118,11 +195,11 @@ pub struct Material {
 }
 
 impl Material {
-    /// A non-emissive, double-sided material of the given kind.
-    pub fn new(name: impl Into<String>, kind: MaterialKind) -> Material {
+    /// A non-emissive, double-sided material scattering as `pbr` says.
+    pub fn new(name: impl Into<String>, pbr: Pbr) -> Material {
         Material {
             name: name.into(),
-            kind,
+            pbr,
             emission: Vec3::ZERO,
             double_sided: true,
             textures: MaterialTextures::default(),
@@ -135,7 +212,23 @@ impl Material {
 
     /// A double-sided Lambertian material.
     pub fn diffuse(name: impl Into<String>, albedo: Vec3) -> Material {
-        Material::new(name, MaterialKind::Diffuse { albedo })
+        Material::new(name, Pbr::diffuse(albedo))
+    }
+
+    /// The material of surfaces whose file gives none (or none gridtrace can use): grey
+    /// plastic, Blender's default material (base 0.8, roughness 0.5, the 4 % dielectric
+    /// layer), which is also what model viewers show. glTF's own default material is a white
+    /// rough metal, which nobody means by leaving the material out.
+    pub fn default_grey(name: impl Into<String>) -> Material {
+        Material::new(
+            name,
+            Pbr {
+                base_colour: Vec3::splat(0.8),
+                metallic: 0.0,
+                roughness: 0.5,
+                ..Pbr::default()
+            },
+        )
     }
 
     /// The same material emitting `radiance`.

@@ -14,7 +14,7 @@ mod texture;
 pub use builder::SceneBuilder;
 pub use camera::{Camera, Projection};
 pub use light::{Light, LightKind};
-pub use material::{AlphaMode, Material, MaterialKind, MaterialTextures};
+pub use material::{AlphaMode, ChannelRef, Material, MaterialTextures, Pbr, f0_of_ior};
 pub use mesh::Mesh;
 pub use texture::{ColorSpace, Filter, Texture, TextureRef, Wrap, srgb_to_linear};
 

@@ -37,11 +37,17 @@ def reset():
 
 
 def principled(name, colour, metallic=0.0, roughness=1.0, transmission=0.0, ior=1.5,
-               emission=None, strength=0.0):
-    """A Principled BSDF material; its inputs are what Blender's glTF exporter reads."""
+               emission=None, strength=0.0, specular=0.0):
+    """A Principled BSDF material; its inputs are what Blender's glTF exporter reads.
+
+    "Specular IOR Level" defaults to 0 here (Blender's own default is 0.5): these scenes are
+    the ideal-material ones, whose Cycles references replace the Principled BSDF by a pure
+    Diffuse BSDF, and level 0 exports as `KHR_materials_specular.specularFactor` 0 (USD
+    `specular` 0), which is exactly that Lambertian for gridtrace too."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Specular IOR Level"].default_value = specular
     bsdf.inputs["Base Color"].default_value = (*colour, 1.0)
     bsdf.inputs["Metallic"].default_value = metallic
     bsdf.inputs["Roughness"].default_value = roughness

@@ -437,6 +437,7 @@ def main():
     parser.add_argument("--samples", type=int, help="total Cycles samples per pixel per scene")
     parser.add_argument("--only", action="append", help="scene name (repeatable)")
     parser.add_argument("--no-export", action="store_true", help="render without rewriting the .glb")
+    parser.add_argument("--export-only", action="store_true", help="rewrite the scene files, render nothing")
     args = parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else None)
 
     os.makedirs(SCENES, exist_ok=True)
@@ -456,7 +457,7 @@ def main():
         for mat in bpy.data.materials:
             if mat.node_tree and mat.node_tree.nodes.get("Principled BSDF"):
                 use_exact_models(mat)
-        if samples == 0:
+        if samples == 0 or args.export_only:
             continue
         for half, seed in (("a", 1), ("b", 2)):
             render(scene, os.path.join(REFERENCES, f"{name}_{half}.exr"), samples // 2, seed)

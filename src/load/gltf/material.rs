@@ -3,95 +3,118 @@
 use glam::{Affine2, Vec2, Vec3};
 
 use super::files::{image_bytes, is_data_uri};
-use super::{GltfLoader, MAX_UV_SETS, ROUGHNESS_WARNING, texture_transform};
+use super::{GltfLoader, MAX_UV_SETS, texture_transform};
 use crate::load::images::decode_texture;
-use crate::scene::{AlphaMode, Filter, Material, MaterialKind, MaterialTextures, TextureRef, Wrap};
+use crate::scene::{
+    AlphaMode, ChannelRef, Filter, Material, MaterialTextures, Pbr, TextureRef, Wrap,
+};
 
 impl GltfLoader {
-    pub(super) fn convert_material(&mut self, material: &gltf::Material) -> Material {
+    /// A glTF material as the one PBR description: `pbrMetallicRoughness`, emission with
+    /// `KHR_materials_emissive_strength`, and the `KHR_materials_{ior, specular,
+    /// transmission, clearcoat, sheen, volume}` extensions (the README's table).
+    pub(super) fn convert_material(
+        &mut self,
+        document: &gltf::Document,
+        material: &gltf::Material,
+    ) -> Material {
         let name = material.name().map_or_else(
             || format!("material {}", material.index().unwrap_or(0)),
             String::from,
         );
-        let pbr = material.pbr_metallic_roughness();
-        let [r, g, b, alpha] = pbr.base_color_factor();
-        let base = Vec3::new(r, g, b);
+        let info_ref = |loader: &mut GltfLoader, info: gltf::texture::Info| {
+            loader.texture_ref(
+                &info.texture(),
+                info.tex_coord(),
+                info.texture_transform(),
+                &name,
+            )
+        };
+        let pbr_gltf = material.pbr_metallic_roughness();
+        let [r, g, b, alpha] = pbr_gltf.base_color_factor();
+        let mut pbr = Pbr {
+            base_colour: Vec3::new(r, g, b),
+            metallic: pbr_gltf.metallic_factor(),
+            roughness: pbr_gltf.roughness_factor(),
+            ior: material.ior().filter(|&ior| ior >= 1.0).unwrap_or(1.5),
+            transmission: material
+                .transmission()
+                .map_or(0.0, |t| t.transmission_factor()),
+            ..Pbr::default()
+        };
         let emission =
             Vec3::from(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0);
-        let transmission = material
-            .transmission()
-            .map_or(0.0, |t| t.transmission_factor());
-        let kind = if transmission >= 0.5 {
-            MaterialKind::Glass {
-                ior: material.ior().unwrap_or(1.5),
-                tint: base,
-            }
-        } else if pbr.metallic_factor() >= 0.5 {
-            MaterialKind::Mirror { reflectance: base }
-        } else {
-            MaterialKind::Diffuse { albedo: base }
-        };
-        let textures = MaterialTextures {
-            base_colour: pbr.base_color_texture().and_then(|info| {
-                self.texture_ref(
-                    &info.texture(),
-                    info.tex_coord(),
-                    info.texture_transform(),
-                    &name,
-                )
+        let metallic_roughness = pbr_gltf
+            .metallic_roughness_texture()
+            .and_then(|info| info_ref(self, info));
+        let mut textures = MaterialTextures {
+            base_colour: pbr_gltf
+                .base_color_texture()
+                .and_then(|info| info_ref(self, info)),
+            emissive: material
+                .emissive_texture()
+                .and_then(|info| info_ref(self, info)),
+            metallic: metallic_roughness.map(|texture| ChannelRef {
+                texture,
+                channel: 2,
             }),
-            emissive: material.emissive_texture().and_then(|info| {
-                self.texture_ref(
-                    &info.texture(),
-                    info.tex_coord(),
-                    info.texture_transform(),
-                    &name,
-                )
+            roughness: metallic_roughness.map(|texture| ChannelRef {
+                texture,
+                channel: 1,
             }),
-            metallic_roughness: pbr.metallic_roughness_texture().and_then(|info| {
-                self.texture_ref(
-                    &info.texture(),
-                    info.tex_coord(),
-                    info.texture_transform(),
-                    &name,
-                )
-            }),
-            metallic_factor: pbr.metallic_factor(),
+            transmission: material
+                .transmission()
+                .and_then(|t| t.transmission_texture())
+                .and_then(|info| info_ref(self, info))
+                .map(|texture| ChannelRef {
+                    texture,
+                    channel: 0,
+                }),
             normal: material.normal_texture().and_then(|info| {
                 let mut r = self.texture_ref(&info.texture(), info.tex_coord(), None, &name)?;
                 // The gltf crate exposes KHR_texture_transform on normal textures only as JSON.
                 if let Some(t) = info.extension_value("KHR_texture_transform") {
-                    let pair = |key: &str, default: f32| {
-                        let v = &t[key];
-                        Vec2::new(
-                            v[0].as_f64().map_or(default, |x| x as f32),
-                            v[1].as_f64().map_or(default, |x| x as f32),
-                        )
-                    };
-                    let rotation = t["rotation"].as_f64().unwrap_or(0.0) as f32;
-                    r.transform =
-                        texture_transform(pair("offset", 0.0), rotation, pair("scale", 1.0));
-                    if let Some(set) = t["texCoord"]
-                        .as_u64()
-                        .filter(|&s| (s as usize) < MAX_UV_SETS)
-                    {
-                        r.texcoord = set as usize;
-                    }
+                    json_texture_transform(t, &mut r);
                 }
                 Some(r)
             }),
             normal_scale: material.normal_texture().map_or(1.0, |n| n.scale()),
+            ..MaterialTextures::default()
         };
-        let roughness = pbr.roughness_factor();
-        let ideal = matches!(
-            kind,
-            MaterialKind::Mirror { .. } | MaterialKind::Glass { .. }
-        ) || textures.metallic_roughness.is_some();
-        if ideal && roughness > ROUGHNESS_WARNING {
-            self.warn(format!(
-                "material '{name}': roughness {roughness} is rendered as perfectly smooth \
-                 (gridtrace's mirror and glass are ideal)"
-            ));
+        if let Some(specular) = material.extension_value("KHR_materials_specular") {
+            pbr.specular = json_f32(&specular["specularFactor"], 1.0).max(0.0);
+            pbr.specular_colour = json_vec3(&specular["specularColorFactor"], Vec3::ONE);
+            self.warn_unread_textures(
+                &name,
+                specular,
+                &["specularTexture", "specularColorTexture"],
+            );
+        }
+        if let Some(coat) = material.extension_value("KHR_materials_clearcoat") {
+            pbr.clearcoat = json_f32(&coat["clearcoatFactor"], 0.0);
+            pbr.clearcoat_roughness = json_f32(&coat["clearcoatRoughnessFactor"], 0.0);
+            textures.clearcoat = self
+                .json_texture(document, &coat["clearcoatTexture"], &name)
+                .map(|texture| ChannelRef {
+                    texture,
+                    channel: 0,
+                });
+            textures.clearcoat_roughness = self
+                .json_texture(document, &coat["clearcoatRoughnessTexture"], &name)
+                .map(|texture| ChannelRef {
+                    texture,
+                    channel: 1,
+                });
+            self.warn_unread_textures(&name, coat, &["clearcoatNormalTexture"]);
+        }
+        if let Some(sheen) = material.extension_value("KHR_materials_sheen") {
+            pbr.sheen_colour = json_vec3(&sheen["sheenColorFactor"], Vec3::ZERO);
+            pbr.sheen_roughness = json_f32(&sheen["sheenRoughnessFactor"], 0.0);
+            self.warn_unread_textures(
+                &name,
+                sheen,
+                &["sheenColorTexture", "sheenRoughnessTexture"],
+            );
         }
         let alpha_mode = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
@@ -111,13 +134,13 @@ impl GltfLoader {
                 Vec3::ZERO
             }
         });
-        // A glass object's back faces are the inside of its volume, which rays leaving it
-        // must cross: glass is always two-sided (Blender writes doubleSided: false with
-        // KHR_materials_volume).
-        let double_sided = material.double_sided() || matches!(kind, MaterialKind::Glass { .. });
+        // A transmitting object's back faces are the inside of its volume, which rays
+        // leaving it must cross: it is always two-sided (Blender writes doubleSided: false
+        // with KHR_materials_volume).
+        let double_sided = material.double_sided() || pbr.transmits();
         Material {
             name,
-            kind,
+            pbr,
             emission,
             double_sided,
             textures,
@@ -125,6 +148,48 @@ impl GltfLoader {
             alpha,
             alpha_mode,
             absorption,
+        }
+    }
+
+    /// A texture named by a texture-info object inside an extension's JSON (the gltf crate
+    /// parses only some extensions); `None` when absent or unusable.
+    fn json_texture(
+        &mut self,
+        document: &gltf::Document,
+        info: &gltf::json::Value,
+        material: &str,
+    ) -> Option<TextureRef> {
+        let index = info["index"].as_u64()?;
+        let Some(texture) = document.textures().nth(index as usize) else {
+            self.warn(format!(
+                "material '{material}': texture {index} does not exist; ignored"
+            ));
+            return None;
+        };
+        let set = info["texCoord"]
+            .as_u64()
+            .unwrap_or(0)
+            .min(u64::from(u32::MAX)) as u32;
+        let mut r = self.texture_ref(&texture, set, None, material)?;
+        if let Some(t) = info["extensions"].get("KHR_texture_transform") {
+            json_texture_transform(t, &mut r);
+        }
+        Some(r)
+    }
+
+    /// Extension textures gridtrace does not read yet get one warning each.
+    fn warn_unread_textures(
+        &mut self,
+        material: &str,
+        extension: &gltf::json::Value,
+        keys: &[&str],
+    ) {
+        for key in keys {
+            if extension.get(key).is_some() {
+                self.warn(format!(
+                    "material '{material}': {key} is not read; its factor is used alone"
+                ));
+            }
         }
     }
 
@@ -214,5 +279,42 @@ impl GltfLoader {
                 ));
             }
         }
+    }
+}
+
+/// A number in extension JSON, or `default` when absent or not finite.
+fn json_f32(value: &gltf::json::Value, default: f32) -> f32 {
+    value
+        .as_f64()
+        .map(|x| x as f32)
+        .filter(|x| x.is_finite())
+        .unwrap_or(default)
+}
+
+/// A three-number array in extension JSON, or `default`.
+fn json_vec3(value: &gltf::json::Value, default: Vec3) -> Vec3 {
+    match value.as_array().map(Vec::as_slice) {
+        Some([x, y, z]) => Vec3::new(
+            json_f32(x, default.x),
+            json_f32(y, default.y),
+            json_f32(z, default.z),
+        ),
+        _ => default,
+    }
+}
+
+/// Applies a `KHR_texture_transform` given as JSON (offset, rotation, scale, texCoord).
+fn json_texture_transform(t: &gltf::json::Value, r: &mut TextureRef) {
+    let pair = |key: &str, default: f32| {
+        let v = &t[key];
+        Vec2::new(json_f32(&v[0], default), json_f32(&v[1], default))
+    };
+    let rotation = json_f32(&t["rotation"], 0.0);
+    r.transform = texture_transform(pair("offset", 0.0), rotation, pair("scale", 1.0));
+    if let Some(set) = t["texCoord"]
+        .as_u64()
+        .filter(|&s| (s as usize) < MAX_UV_SETS)
+    {
+        r.texcoord = set as usize;
     }
 }

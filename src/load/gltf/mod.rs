@@ -1,9 +1,6 @@
 //! glTF 2.0 (`.gltf` with external or embedded buffers, and `.glb`) through the `gltf` crate.
 //!
-//! Material mapping (see the README's table): emission = `emissiveFactor` ×
-//! `KHR_materials_emissive_strength`; `KHR_materials_transmission` ≥ 0.5 → glass with
-//! `KHR_materials_ior` (default 1.5) tinted by the base colour; else `metallicFactor` ≥ 0.5 →
-//! mirror with reflectance = base colour; else Lambertian with the base colour.
+//! Materials become the one PBR description ([`crate::scene::Pbr`]) in `material.rs`.
 
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -29,14 +26,13 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_texture_transform",
     "KHR_materials_volume",
+    "KHR_materials_specular",
+    "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
 ];
 
 /// Texture-coordinate sets read (`TEXCOORD_0` to `TEXCOORD_3`).
 const MAX_UV_SETS: usize = 4;
-
-/// Roughness above which a mirror or glass material draws a warning that it is rendered
-/// ideal.
-const ROUGHNESS_WARNING: f32 = 0.05;
 
 /// Luminous efficacy the glTF specification's photometric units assume (lm/W).
 const LUMENS_PER_WATT: f32 = 683.0;
@@ -45,9 +41,6 @@ const LUMENS_PER_WATT: f32 = 683.0;
 const MAX_NODE_DEPTH: usize = 256;
 /// Most node visits in one scene (instancing through shared children multiplies visits).
 const MAX_NODE_VISITS: usize = 1_000_000;
-/// Grey for primitives without a material. glTF's default material is fully metallic,
-/// which would turn them into mirrors; viewers show grey plastic, and so do we.
-const DEFAULT_ALBEDO: f32 = 0.8;
 
 /// Loads a `.gltf` or `.glb` file with default options.
 pub fn load(path: &Path) -> Result<Loaded, LoadError> {
@@ -103,7 +96,7 @@ pub fn load_bytes_with(
     };
     loader.warn_about_unreadable_images(&document);
     for material in document.materials() {
-        let m = loader.convert_material(&material);
+        let m = loader.convert_material(&document, &material);
         loader
             .normal_mapped
             .push(m.textures.normal.map(|n| n.texcoord));
@@ -262,10 +255,9 @@ impl GltfLoader {
         if let Some(i) = primitive.material().index() {
             return i;
         }
-        *self.default_material.get_or_insert_with(|| {
-            self.builder
-                .add_material(Material::diffuse("default", Vec3::splat(DEFAULT_ALBEDO)))
-        })
+        *self
+            .default_material
+            .get_or_insert_with(|| self.builder.add_material(Material::default_grey("default")))
     }
 
     fn load_scene(&mut self, document: &gltf::Document) -> Result<(), LoadError> {

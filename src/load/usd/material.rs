@@ -10,7 +10,7 @@ use crate::limits::memory_budget;
 use crate::load::access::read_regular_file;
 use crate::load::images::decode_texture;
 use crate::scene::{
-    AlphaMode, ColorSpace, Material, MaterialKind, MaterialTextures, TextureRef, Wrap,
+    AlphaMode, ChannelRef, ColorSpace, Material, MaterialTextures, Pbr, TextureRef, Wrap, f0_of_ior,
 };
 
 impl UsdLoader {
@@ -23,7 +23,7 @@ impl UsdLoader {
             return variant;
         }
         let mut material = self.builder.material_mut(index).clone();
-        let variant = if matches!(material.kind, MaterialKind::Glass { .. }) {
+        let variant = if material.pbr.transmits() {
             index
         } else {
             material.double_sided = false;
@@ -58,9 +58,7 @@ impl UsdLoader {
         if let Some(m) = self.default_material {
             return m;
         }
-        let m = self
-            .builder
-            .add_material(Material::diffuse("default", Vec3::splat(0.8)));
+        let m = self.builder.add_material(Material::default_grey("default"));
         self.default_material = Some(m);
         m
     }
@@ -71,19 +69,18 @@ impl UsdLoader {
         let surface = self.connected_prim(material, "outputs:surface");
         let Some(shader) = surface else {
             self.warn(format!(
-                "{name}: material has no surface shader; using grey diffuse"
+                "{name}: material has no surface shader; using grey plastic"
             ));
-            return Material::diffuse(name, Vec3::splat(0.8));
+            return Material::default_grey(name);
         };
         let id = self.get_token(&shader, "info:id").unwrap_or_default();
         if id != "UsdPreviewSurface" {
             self.warn(format!(
-                "{name}: surface shader '{id}' is not UsdPreviewSurface; using grey diffuse"
+                "{name}: surface shader '{id}' is not UsdPreviewSurface; using grey plastic"
             ));
-            return Material::diffuse(name, Vec3::splat(0.8));
+            return Material::default_grey(name);
         }
         let mut textures = MaterialTextures {
-            metallic_factor: 0.0,
             normal_scale: 1.0,
             ..MaterialTextures::default()
         };
@@ -133,29 +130,81 @@ impl UsdLoader {
             }
             opacity = 1.0;
         }
-        let metallic = self.constant_scalar(&shader, "inputs:metallic", 0.0, &name);
         let ior = self.constant_scalar(&shader, "inputs:ior", 1.5, &name);
-        let roughness = self.constant_scalar(&shader, "inputs:roughness", 0.5, &name);
-        let kind = if opacity < 0.5 {
-            MaterialKind::Glass { ior, tint: diffuse }
-        } else if metallic >= 0.5 {
-            MaterialKind::Mirror {
-                reflectance: diffuse,
-            }
-        } else {
-            MaterialKind::Diffuse { albedo: diffuse }
+        let (metallic, metallic_texture) =
+            self.scalar_input(&shader, "inputs:metallic", 0.0, &name);
+        let (roughness, roughness_texture) =
+            self.scalar_input(&shader, "inputs:roughness", 0.5, &name);
+        let (clearcoat, clearcoat_texture) =
+            self.scalar_input(&shader, "inputs:clearcoat", 0.0, &name);
+        let (clearcoat_roughness, clearcoat_roughness_texture) =
+            self.scalar_input(&shader, "inputs:clearcoatRoughness", 0.01, &name);
+        textures.metallic = metallic_texture;
+        textures.roughness = roughness_texture;
+        textures.clearcoat = clearcoat_texture;
+        textures.clearcoat_roughness = clearcoat_roughness_texture;
+        let mut pbr = Pbr {
+            base_colour: diffuse,
+            metallic,
+            roughness,
+            ior,
+            clearcoat,
+            clearcoat_roughness,
+            // UsdPreviewSurface: below full opacity the surface refracts with `ior`.
+            transmission: (1.0 - opacity).clamp(0.0, 1.0),
+            ..Pbr::default()
         };
-        if !matches!(kind, MaterialKind::Diffuse { .. }) && roughness > 0.05 {
-            self.warn(format!(
-                "{name}: roughness {roughness} is rendered as perfectly smooth (gridtrace's mirror and glass are ideal)"
-            ));
+        if self.get_f32(&shader, "inputs:useSpecularWorkflow") == Some(1.0) {
+            // The specular workflow gives F0 directly and has no metals.
+            let specular = self.constant_colour(&shader, "inputs:specularColor", Vec3::ZERO);
+            pbr.metallic = 0.0;
+            textures.metallic = None;
+            pbr.specular_colour = specular / f0_of_ior(ior).max(1e-4);
+        } else if let Some(level) = self.get_f32(&shader, "inputs:specular") {
+            // Blender writes its "Specular IOR Level" here (not a UsdPreviewSurface input):
+            // 0.5 is the plain F0 of the ior, and the level scales F0 by 2·level.
+            let scale = (2.0 * level).max(0.0);
+            pbr.specular = scale.min(1.0);
+            pbr.specular_colour = Vec3::splat(scale.max(1.0));
         }
         Material {
             emission,
             textures,
             alpha_mode,
-            ..Material::new(name, kind)
+            ..Material::new(name, pbr)
         }
+    }
+
+    /// A scalar input: its constant (or `default`), or a texture channel with the texture's
+    /// `scale` for that channel as the factor.
+    fn scalar_input(
+        &mut self,
+        shader: &sdf::Path,
+        input: &str,
+        default: f32,
+        material: &str,
+    ) -> (f32, Option<ChannelRef>) {
+        let channel =
+            self.connected_output(shader, input)
+                .and_then(|output| match output.as_str() {
+                    "outputs:r" => Some(0),
+                    "outputs:g" => Some(1),
+                    "outputs:b" => Some(2),
+                    "outputs:a" => Some(3),
+                    _ => None,
+                });
+        if let Some(channel) = channel
+            && let Some((texture, _)) =
+                self.texture_input(shader, input, ColorSpace::Linear, material)
+        {
+            let node = self.connected_prim(shader, input);
+            let factor = match node.and_then(|n| self.get(&n, "inputs:scale")) {
+                Some(sdf::Value::Vec4f(v)) => [v.x, v.y, v.z, v.w][channel],
+                _ => 1.0,
+            };
+            return (factor, Some(ChannelRef { texture, channel }));
+        }
+        (self.constant_scalar(shader, input, default, material), None)
     }
 
     pub(super) fn constant_colour(
@@ -280,6 +329,18 @@ impl UsdLoader {
         };
         self.textures.insert(file.to_string(), decoded);
         decoded
+    }
+
+    /// The name of the output (`outputs:r`, …) that feeds `property` of `prim`, if any.
+    pub(super) fn connected_output(&self, prim: &sdf::Path, property: &str) -> Option<String> {
+        let attribute = self.stage.attribute(prim.append_property(property).ok()?);
+        let source = attribute.connections().ok()?.into_iter().next()?;
+        let path = source.as_str();
+        Some(
+            path.rsplit_once('.')
+                .map_or(path, |(_, name)| name)
+                .to_string(),
+        )
     }
 
     /// The prim whose output feeds `property` of `prim` (its first connection), if any.

@@ -1,0 +1,232 @@
+//! Directional albedo tables: how much of the light arriving from a direction a lobe
+//! reflects, E(μ) = ∫ f(wo, wi) cos θi dωi, and its cosine-weighted average Ē = ∫ 2μ E(μ) dμ.
+//! Energy compensation (Kulla & Conty 2017, "Revisiting physically based shading at
+//! Imageworks") and the layering of lobes over one another are built from them.
+//!
+//! The tables are integrated once per process, on first use, with stratified samples of the
+//! lobes' own sampling routines (a few milliseconds), so they always describe exactly the
+//! lobes that are rendered. Between grid points they are linear in μ and in roughness, and
+//! the averages are the exact integrals of that interpolation, so Ē and E always agree.
+
+use std::sync::OnceLock;
+
+use glam::{Vec2, Vec3};
+
+use super::fresnel::schlick_weight;
+use super::microfacet::{DELTA_ALPHA, Ggx, reflect};
+use super::sheen::{SHEEN_MIN_ALPHA, charlie_brdf};
+
+/// Grid points in μ = cos θ and in perceptual roughness, each over [0, 1].
+const N: usize = 32;
+
+/// Stratified samples per table entry, per axis.
+const STRATA: usize = 24;
+
+/// Albedo tables of the lobes whose reflectance is not known in closed form.
+pub struct AlbedoTables {
+    /// Split-sum terms of GGX with Schlick's Fresnel: E(μ) = F0·A + F90·B. Index
+    /// `roughness · N + μ`.
+    schlick: Vec<Vec2>,
+    /// Cosine-weighted averages of A and B per roughness.
+    schlick_average: Vec<Vec2>,
+    /// Albedo of the Charlie sheen lobe with a white sheen colour.
+    sheen: Vec<f32>,
+}
+
+/// The process's tables, integrated on first use.
+pub fn tables() -> &'static AlbedoTables {
+    static TABLES: OnceLock<AlbedoTables> = OnceLock::new();
+    TABLES.get_or_init(AlbedoTables::integrate)
+}
+
+impl AlbedoTables {
+    fn integrate() -> AlbedoTables {
+        let mut schlick = Vec::with_capacity(N * N);
+        let mut sheen = Vec::with_capacity(N * N);
+        for j in 0..N {
+            let roughness = grid(j);
+            let ggx = Ggx {
+                alpha: (roughness * roughness).max(DELTA_ALPHA),
+            };
+            let sheen_alpha = (roughness * roughness).max(SHEEN_MIN_ALPHA);
+            for i in 0..N {
+                let mu = grid(i).max(1e-4);
+                let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+                schlick.push(integrate_schlick(&ggx, wo));
+                sheen.push(integrate_sheen(sheen_alpha, wo));
+            }
+        }
+        let schlick_average = (0..N)
+            .map(|j| cosine_average(|i| schlick[j * N + i]))
+            .collect();
+        AlbedoTables {
+            schlick,
+            schlick_average,
+            sheen,
+        }
+    }
+
+    /// (A, B) at (μ, roughness): GGX's albedo with Schlick's Fresnel is F0·A + F90·B.
+    pub fn schlick(&self, mu: f32, roughness: f32) -> Vec2 {
+        bilinear(&self.schlick, mu, roughness)
+    }
+
+    /// Cosine-weighted averages (Ā, B̄) at `roughness`.
+    pub fn schlick_average(&self, roughness: f32) -> Vec2 {
+        linear(&self.schlick_average, roughness)
+    }
+
+    /// Albedo of the white Charlie sheen at (μ, roughness).
+    pub fn sheen(&self, mu: f32, roughness: f32) -> f32 {
+        bilinear(&self.sheen, mu, roughness)
+    }
+}
+
+fn grid(i: usize) -> f32 {
+    i as f32 / (N - 1) as f32
+}
+
+fn strata() -> impl Iterator<Item = Vec2> {
+    (0..STRATA * STRATA).map(|k| {
+        Vec2::new(
+            ((k % STRATA) as f32 + 0.5) / STRATA as f32,
+            ((k / STRATA) as f32 + 0.5) / STRATA as f32,
+        )
+    })
+}
+
+/// (A, B) by sampling visible normals: each sample weighs G2/G1 (Heitz 2018, eq. 19).
+fn integrate_schlick(ggx: &Ggx, wo: Vec3) -> Vec2 {
+    let mut sum = Vec2::ZERO;
+    for u in strata() {
+        let h = ggx.sample_visible(wo, u);
+        let wi = reflect(wo, h);
+        if wi.z <= 0.0 {
+            continue;
+        }
+        let weight = ggx.g2(wo, wi) / ggx.g1(wo);
+        let s = schlick_weight(wo.dot(h));
+        sum += weight * Vec2::new(1.0 - s, s);
+    }
+    sum / (STRATA * STRATA) as f32
+}
+
+/// The white sheen's albedo by the midpoint rule over (s, φ) with μi = s², which crowds
+/// the nodes towards grazing directions where the sheen peaks (cosine sampling from
+/// stratified numbers never reaches them): E = ∫∫ f·μi dμi dφ = ∫∫ f·s²·2s ds dφ, over half
+/// the φ range since `wo` lies in the xz-plane.
+fn integrate_sheen(alpha: f32, wo: Vec3) -> f32 {
+    const S: usize = 48;
+    const PHI: usize = 24;
+    let mut sum = 0.0;
+    for i in 0..S {
+        let s = (i as f32 + 0.5) / S as f32;
+        let mu = s * s;
+        let r = (1.0 - mu * mu).max(0.0).sqrt();
+        for j in 0..PHI {
+            let phi = std::f32::consts::PI * (j as f32 + 0.5) / PHI as f32;
+            let wi = Vec3::new(r * phi.cos(), r * phi.sin(), mu);
+            sum += charlie_brdf(alpha, wo, wi) * mu * 2.0 * s;
+        }
+    }
+    sum * 2.0 * std::f32::consts::PI / (S * PHI) as f32
+}
+
+/// ∫ 2μ E(μ) dμ of the piecewise-linear E through the grid values, exactly: on [a, b] the
+/// integral of 2μ·(eₐ + (e_b − eₐ)(μ − a)/(b − a)) is (b − a)·(eₐ(2a + b) + e_b(a + 2b))/3.
+fn cosine_average(value: impl Fn(usize) -> Vec2) -> Vec2 {
+    (0..N - 1)
+        .map(|i| {
+            let (a, b) = (grid(i), grid(i + 1));
+            (b - a) * (value(i) * (2.0 * a + b) + value(i + 1) * (a + 2.0 * b)) / 3.0
+        })
+        .sum()
+}
+
+fn position(x: f32) -> (usize, f32) {
+    let x = x.clamp(0.0, 1.0) * (N - 1) as f32;
+    let i = (x as usize).min(N - 2);
+    (i, x - i as f32)
+}
+
+fn linear<T>(values: &[T], x: f32) -> T
+where
+    T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
+{
+    let (i, t) = position(x);
+    values[i] * (1.0 - t) + values[i + 1] * t
+}
+
+fn bilinear<T>(values: &[T], mu: f32, roughness: f32) -> T
+where
+    T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
+{
+    let (j, t) = position(roughness);
+    linear(&values[j * N..(j + 1) * N], mu) * (1.0 - t) + linear(&values[(j + 1) * N..], mu) * t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A smooth GGX lobe reflects everything; a rough one loses energy to masking: on
+    /// average about 60 % for α = 1 (Kulla & Conty 2017, fig. 2), most of it at normal
+    /// incidence, where the widest microfacets send light below the horizon.
+    #[test]
+    fn single_scattering_albedo_falls_with_roughness() {
+        let t = tables();
+        let e = |mu, r| t.schlick(mu, r).element_sum();
+        assert!((e(1.0, 0.05) - 1.0).abs() < 0.01, "{}", e(1.0, 0.05));
+        assert!(e(1.0, 0.5) < 0.95 && e(1.0, 0.5) > 0.85, "{}", e(1.0, 0.5));
+        assert!(e(1.0, 1.0) > 0.25 && e(1.0, 1.0) < 0.4, "{}", e(1.0, 1.0));
+        let avg = |r| t.schlick_average(r).element_sum();
+        assert!(avg(1.0) > 0.35 && avg(1.0) < 0.5, "{}", avg(1.0));
+        assert!(avg(0.2) > avg(0.5) && avg(0.5) > avg(1.0));
+        // Schlick's grazing term B is what F90 weighs: large only near grazing incidence.
+        assert!(t.schlick(0.1, 0.2).y > 0.3 && t.schlick(1.0, 0.2).y < 1e-3);
+    }
+
+    /// The sheen table against plain Monte Carlo (uniform hemisphere sampling, which reaches
+    /// grazing directions), at grid points and between them.
+    #[test]
+    fn sheen_table_matches_monte_carlo() {
+        let t = tables();
+        for roughness in [0.3f32, 0.5, 1.0] {
+            for mu in [0.05f32, 0.2, 0.5, 0.9] {
+                let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+                let mut rng = crate::render::sampling::Rng::new(1, 1);
+                let n = 1_000_000;
+                let mut sum = 0.0f64;
+                for _ in 0..n {
+                    let u = rng.uniform2();
+                    let z = u.x;
+                    let r = (1.0 - z * z).sqrt();
+                    let phi = std::f32::consts::TAU * u.y;
+                    let wi = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                    sum += f64::from(charlie_brdf(roughness * roughness, wo, wi) * z);
+                }
+                let mc = sum / n as f64 * std::f64::consts::TAU;
+                let table = f64::from(t.sheen(mu, roughness));
+                assert!(
+                    (table - mc).abs() < 0.01 * mc.max(0.1),
+                    "roughness {roughness}, μ {mu}: table {table} vs Monte Carlo {mc}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn interpolation_is_exact_at_grid_points_and_linear_between() {
+        let values: Vec<f32> = (0..N * N).map(|k| k as f32).collect();
+        assert_eq!(bilinear(&values, grid(3), grid(5)), (5 * N + 3) as f32);
+        let mid = bilinear(&values, 0.5 * (grid(3) + grid(4)), grid(5));
+        assert!((mid - ((5 * N + 3) as f32 + 0.5)).abs() < 1e-3);
+        // The average of a constant is that constant.
+        assert!(
+            (cosine_average(|_| Vec2::ONE) - Vec2::ONE)
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+    }
+}

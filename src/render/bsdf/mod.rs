@@ -1,0 +1,427 @@
+//! The surface scattering model: one [`Bsdf`] per shading point, made from the scene's
+//! [`Pbr`] description by [`Bsdf::new`], the one place that decides which lobes a material
+//! has and how they stack (glTF 2.0 Appendix B and its KHR material extensions):
+//!
+//! ```text
+//! coat  ─ clear GGX dielectric (F0 0.04 · clearcoat)
+//!  └ sheen ─ Charlie sheen
+//!     └ metallic · GGX conductor (F0 = base colour)
+//!       + (1 − metallic)(1 − transmission) · [GGX dielectric layer over Lambertian base]
+//!       + (1 − metallic) · transmission · rough or smooth glass (tinted by base colour)
+//! ```
+//!
+//! Each layer passes to what lies beneath it the energy it does not reflect towards the
+//! viewer, 1 − E(μo) ([`specular::SpecularLobe::transmitted`]), as Cycles' Principled BSDF
+//! does, so a white stack reflects exactly what arrives. Each lobe is reciprocal; the
+//! stack, like Cycles', is not. Sampling picks a strategy in proportion to
+//! each lobe's estimated albedo; every non-delta lobe takes part in `eval` and `pdf`, so
+//! light sampling and MIS see all of them.
+//!
+//! Directions are world-space unit vectors pointing away from the surface. `n` is the
+//! shading normal turned to the side `wo` lies on (see [`crate::render::integrator`]).
+
+mod albedo;
+mod fresnel;
+mod glass;
+mod microfacet;
+mod sheen;
+mod specular;
+
+pub use fresnel::fresnel_dielectric;
+
+use std::f32::consts::FRAC_1_PI;
+
+use glam::{Vec2, Vec3};
+
+use super::sampling::{Frame, cosine_hemisphere};
+use crate::scene::{Pbr, f0_of_ior};
+use glass::GlassLobe;
+use sheen::charlie_brdf;
+use specular::SpecularLobe;
+
+/// F0 of the clear coat: a dielectric of index 1.5, as `KHR_materials_clearcoat` fixes it.
+const COAT_F0: f32 = 0.04;
+
+/// The lobes of one material at one point, with their weights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bsdf {
+    /// Lambertian albedo of the dielectric base, before the specular layer takes its share.
+    diffuse: Vec3,
+    /// The dielectric specular layer over the diffuse base, and its weight.
+    specular: Option<(SpecularLobe, f32)>,
+    /// The conductor and its weight.
+    metal: Option<(SpecularLobe, f32)>,
+    /// The transmitting dielectric and its weight.
+    glass: Option<(GlassLobe, f32)>,
+    /// The clear coat over everything.
+    coat: Option<SpecularLobe>,
+    /// Sheen colour and α, between the coat and the rest.
+    sheen: Option<(Vec3, f32)>,
+}
+
+/// A direction drawn from a BSDF.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// Incident direction (towards the next vertex).
+    pub wi: Vec3,
+    /// f·|cos θi| / pdf: what the path throughput is multiplied by.
+    pub weight: Vec3,
+    /// Solid-angle density of `wi`; for delta lobes the discrete probability of the lobe.
+    pub pdf: f32,
+    /// True for a delta lobe, which light sampling can never produce.
+    pub is_delta: bool,
+    /// True when `wi` crosses the surface.
+    pub is_transmission: bool,
+    /// The factor radiance is scaled by at a refraction, (η_i/η_t)²; 1 otherwise.
+    pub eta_scale: f32,
+}
+
+/// The ways [`Bsdf::sample`] draws a direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Strategy {
+    /// Cosine-weighted: the diffuse base, the sheen and the multiple-scattering lobes.
+    Cosine,
+    Coat,
+    Metal,
+    Specular,
+    Glass,
+}
+
+const STRATEGIES: [Strategy; 5] = [
+    Strategy::Cosine,
+    Strategy::Coat,
+    Strategy::Metal,
+    Strategy::Specular,
+    Strategy::Glass,
+];
+
+impl Bsdf {
+    /// The lobes of `pbr` for a ray arriving on the `front` side of the surface (which for
+    /// transmission decides whether it enters or leaves).
+    pub fn new(pbr: &Pbr, front: bool) -> Bsdf {
+        let metallic = pbr.metallic.clamp(0.0, 1.0);
+        let transmission = pbr.transmission.clamp(0.0, 1.0);
+        let roughness = pbr.roughness.clamp(0.0, 1.0);
+        let dielectric = (1.0 - metallic) * (1.0 - transmission);
+        let base = pbr.base_colour.clamp(Vec3::ZERO, Vec3::ONE);
+        let positive = |w: f32| (w > 0.0).then_some(w);
+        let strength = pbr.specular.clamp(0.0, 1.0);
+        let specular = positive(dielectric * strength).map(|_| {
+            // KHR_materials_specular: F0 = min(F0(ior)·specularColour, 1)·specular and
+            // F90 = specular.
+            let f0 = (f0_of_ior(pbr.ior) * pbr.specular_colour).min(Vec3::ONE) * strength;
+            (SpecularLobe::new(roughness, f0, strength), dielectric)
+        });
+        let metal = positive(metallic).map(|w| (SpecularLobe::new(roughness, base, 1.0), w));
+        let eta = if front { pbr.ior } else { 1.0 / pbr.ior };
+        let glass = positive((1.0 - metallic) * transmission)
+            .map(|w| (GlassLobe::new(roughness, eta, base), w));
+        let coat = positive(pbr.clearcoat.min(1.0)).map(|c| {
+            SpecularLobe::new(
+                pbr.clearcoat_roughness.clamp(0.0, 1.0),
+                Vec3::splat(COAT_F0 * c),
+                c,
+            )
+        });
+        let sheen = (pbr.sheen_colour.max_element() > 0.0).then(|| {
+            (
+                pbr.sheen_colour.clamp(Vec3::ZERO, Vec3::ONE),
+                pbr.sheen_roughness.clamp(0.0, 1.0),
+            )
+        });
+        Bsdf {
+            diffuse: base * dielectric,
+            specular,
+            metal,
+            glass,
+            coat,
+            sheen,
+        }
+    }
+
+    /// A pure Lambertian BSDF.
+    pub fn lambertian(albedo: Vec3) -> Bsdf {
+        Bsdf::new(&Pbr::diffuse(albedo), true)
+    }
+
+    /// Names of the lobes, for `--inspect` and messages.
+    pub fn lobe_names(&self) -> Vec<&'static str> {
+        let mut names = Vec::new();
+        let sharp = |delta: bool, smooth, rough| if delta { smooth } else { rough };
+        if let Some(c) = &self.coat {
+            names.push(sharp(c.is_delta(), "smooth coat", "rough coat"));
+        }
+        if self.sheen.is_some() {
+            names.push("sheen");
+        }
+        if let Some((m, _)) = &self.metal {
+            names.push(sharp(m.is_delta(), "mirror conductor", "GGX conductor"));
+        }
+        if let Some((s, _)) = &self.specular {
+            names.push(sharp(
+                s.is_delta(),
+                "smooth specular layer",
+                "GGX specular layer",
+            ));
+        }
+        if self.diffuse.max_element() > 0.0 {
+            names.push("Lambertian");
+        }
+        if let Some((g, _)) = &self.glass {
+            names.push(sharp(g.is_delta(), "smooth glass", "rough glass"));
+        }
+        names
+    }
+
+    /// True when every lobe is a delta (light sampling is useless there).
+    pub fn is_delta(&self) -> bool {
+        !self.has_cosine_lobes()
+            && self.coat.is_none_or(|c| c.is_delta())
+            && self.metal.is_none_or(|(m, _)| m.is_delta())
+            && self.specular.is_none_or(|(s, _)| s.is_delta())
+            && self.glass.is_none_or(|(g, _)| g.is_delta())
+    }
+
+    fn has_cosine_lobes(&self) -> bool {
+        self.diffuse.max_element() > 0.0
+            || self.sheen.is_some()
+            || [
+                self.coat,
+                self.metal.map(|m| m.0),
+                self.specular.map(|s| s.0),
+            ]
+            .iter()
+            .flatten()
+            .any(|l| !l.is_delta())
+    }
+
+    /// The factor the coat and sheen leave to what lies beneath them.
+    fn beneath_top(&self, mu_o: f32) -> Vec3 {
+        let mut factor = Vec3::ONE;
+        if let Some(coat) = &self.coat {
+            factor *= coat.transmitted(mu_o);
+        }
+        if let Some((colour, roughness)) = self.sheen {
+            factor *= sheen_transmitted(colour, roughness, mu_o);
+        }
+        factor
+    }
+
+    /// f(wo, wi) in the local frame, for every non-delta lobe.
+    fn eval_local(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if wo.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let mu_o = wo.z;
+        let beneath = self.beneath_top(mu_o);
+        let mut f = Vec3::ZERO;
+        if let Some((glass, w)) = &self.glass {
+            f += beneath * glass.eval(wo, wi) * *w;
+        }
+        if wi.z <= 0.0 {
+            return f;
+        }
+        if let Some(coat) = &self.coat {
+            f += coat.eval(wo, wi);
+        }
+        if let Some((colour, roughness)) = self.sheen {
+            let factor = self.coat.map_or(Vec3::ONE, |c| c.transmitted(mu_o));
+            f += factor * colour * charlie_brdf(roughness * roughness, wo, wi);
+        }
+        if let Some((metal, w)) = &self.metal {
+            f += beneath * metal.eval(wo, wi) * *w;
+        }
+        let mut base = self.diffuse * FRAC_1_PI;
+        if let Some((specular, w)) = &self.specular {
+            base *= specular.transmitted(mu_o);
+            f += beneath * specular.eval(wo, wi) * *w;
+        }
+        f + beneath * base
+    }
+
+    /// How often each strategy is chosen, in proportion to the albedo it covers at `wo`.
+    fn strategy_weights(&self, mu_o: f32) -> [f32; 5] {
+        let mean = |v: Vec3| v.element_sum() / 3.0;
+        let mut top = 1.0;
+        let mut coat = 0.0;
+        let mut cosine = 0.0;
+        if let Some(c) = &self.coat {
+            coat = mean(c.single_albedo(mu_o));
+            cosine += mean(c.albedo(mu_o)) - coat;
+            top = 1.0 - mean(c.albedo(mu_o));
+        }
+        if let Some((colour, roughness)) = self.sheen {
+            let e = colour.max_element() * albedo::tables().sheen(mu_o, roughness);
+            cosine += top * e;
+            top *= 1.0 - e;
+        }
+        let mut metal = 0.0;
+        if let Some((m, w)) = &self.metal {
+            metal = top * w * mean(m.single_albedo(mu_o));
+            cosine += top * w * mean(m.albedo(mu_o) - m.single_albedo(mu_o));
+        }
+        let mut specular = 0.0;
+        let mut under = Vec3::ONE;
+        if let Some((s, w)) = &self.specular {
+            specular = top * w * mean(s.single_albedo(mu_o));
+            cosine += top * w * mean(s.albedo(mu_o) - s.single_albedo(mu_o));
+            under = Vec3::ONE - s.albedo(mu_o);
+        }
+        cosine += top * mean(self.diffuse * under);
+        // Glass passes or reflects almost everything, whatever its tint.
+        let glass = self.glass.map_or(0.0, |(_, w)| top * w);
+        [cosine, coat, metal, specular, glass].map(|w| w.max(0.0))
+    }
+
+    /// Solid-angle pdf of `wi` over the non-delta strategies, local frame.
+    fn pdf_local(&self, wo: Vec3, wi: Vec3, weights: &[f32; 5]) -> f32 {
+        let total: f32 = weights.iter().sum();
+        if total <= 0.0 || wo.z <= 0.0 {
+            return 0.0;
+        }
+        let mut pdf = 0.0;
+        for (strategy, &w) in STRATEGIES.iter().zip(weights) {
+            if w == 0.0 {
+                continue;
+            }
+            let p = match strategy {
+                Strategy::Cosine => wi.z.max(0.0) * FRAC_1_PI,
+                Strategy::Coat => self.coat.map_or(0.0, |c| c.pdf_visible(wo, wi)),
+                Strategy::Metal => self.metal.map_or(0.0, |(m, _)| m.pdf_visible(wo, wi)),
+                Strategy::Specular => self.specular.map_or(0.0, |(s, _)| s.pdf_visible(wo, wi)),
+                Strategy::Glass => self.glass.map_or(0.0, |(g, _)| g.pdf(wo, wi)),
+            };
+            pdf += w * p;
+        }
+        pdf / total
+    }
+
+    /// f(wo, wi) over the non-delta lobes; zero for delta lobes.
+    pub fn eval(&self, n: Vec3, wo: Vec3, wi: Vec3) -> Vec3 {
+        let frame = Frame::from_normal(n);
+        self.eval_local(frame.to_local(wo), frame.to_local(wi))
+    }
+
+    /// Solid-angle pdf with which [`Bsdf::sample`] picks `wi` by its non-delta strategies.
+    pub fn pdf(&self, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
+        let frame = Frame::from_normal(n);
+        let wo = frame.to_local(wo);
+        let weights = self.strategy_weights(wo.z);
+        self.pdf_local(wo, frame.to_local(wi), &weights)
+    }
+
+    /// Draws an incident direction. `u` places it within the chosen strategy, `u_lobe`
+    /// chooses the strategy (and then reflection or refraction at glass).
+    pub fn sample(&self, n: Vec3, wo: Vec3, u: Vec2, u_lobe: f32) -> Option<BsdfSample> {
+        let frame = Frame::from_normal(n);
+        let wo = frame.to_local(wo);
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let weights = self.strategy_weights(wo.z);
+        let total: f32 = weights.iter().sum();
+        if total <= 0.0 {
+            return None;
+        }
+        // Choose a strategy, and keep the remainder of `u_lobe` uniform for the next choice.
+        let mut target = u_lobe * total;
+        let mut chosen = Strategy::Cosine;
+        let mut probability = 0.0;
+        for (strategy, &w) in STRATEGIES.iter().zip(&weights) {
+            if w > 0.0 {
+                chosen = *strategy;
+                probability = w / total;
+                if target < w {
+                    break;
+                }
+                target -= w;
+            }
+        }
+        let u_rest = (target / (probability * total)).clamp(0.0, 1.0 - f32::EPSILON);
+        let delta = self.sample_delta(chosen, wo, u_rest);
+        if let Some((wi, value, p, is_transmission)) = delta {
+            let scale = self.glass.map_or(1.0, |(g, _)| 1.0 / (g.eta() * g.eta()));
+            return Some(BsdfSample {
+                wi: frame.to_world(wi),
+                weight: value / (p * probability),
+                pdf: p * probability,
+                is_delta: true,
+                is_transmission,
+                eta_scale: if is_transmission { scale } else { 1.0 },
+            });
+        }
+        let wi = match chosen {
+            Strategy::Cosine => Some(cosine_hemisphere(u)),
+            Strategy::Coat => self.coat.and_then(|c| c.sample_visible(wo, u)),
+            Strategy::Metal => self.metal.and_then(|(m, _)| m.sample_visible(wo, u)),
+            Strategy::Specular => self.specular.and_then(|(s, _)| s.sample_visible(wo, u)),
+            Strategy::Glass => self.glass.and_then(|(g, _)| g.sample_rough(wo, u, u_rest)),
+        }?;
+        let pdf = self.pdf_local(wo, wi, &weights);
+        let f = self.eval_local(wo, wi);
+        if pdf <= 0.0 || f == Vec3::ZERO {
+            return None;
+        }
+        let is_transmission = wi.z < 0.0;
+        let eta_scale = match self.glass {
+            Some((g, _)) if is_transmission => 1.0 / (g.eta() * g.eta()),
+            _ => 1.0,
+        };
+        Some(BsdfSample {
+            wi: frame.to_world(wi),
+            weight: f * (wi.z.abs() / pdf),
+            pdf,
+            is_delta: false,
+            is_transmission,
+            eta_scale,
+        })
+    }
+
+    /// The direction, value f·|cos| (the delta's integral), choice probability within the
+    /// strategy and crossing of a delta lobe, when `strategy` is one.
+    fn sample_delta(
+        &self,
+        strategy: Strategy,
+        wo: Vec3,
+        u_choice: f32,
+    ) -> Option<(Vec3, Vec3, f32, bool)> {
+        let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
+        let mu = wo.z;
+        match strategy {
+            Strategy::Coat => {
+                let c = self.coat.filter(|c| c.is_delta())?;
+                Some((mirror, c.albedo(mu), 1.0, false))
+            }
+            Strategy::Metal => {
+                let (m, w) = self.metal.filter(|(m, _)| m.is_delta())?;
+                Some((mirror, self.beneath_top(mu) * m.albedo(mu) * w, 1.0, false))
+            }
+            Strategy::Specular => {
+                let (s, w) = self.specular.filter(|(s, _)| s.is_delta())?;
+                Some((mirror, self.beneath_top(mu) * s.albedo(mu) * w, 1.0, false))
+            }
+            Strategy::Glass => {
+                let (g, w) = self.glass.filter(|(g, _)| g.is_delta())?;
+                let s = g.sample_delta(wo, u_choice)?;
+                let beneath = self.beneath_top(mu);
+                Some((
+                    s.wi,
+                    beneath * s.value * w,
+                    s.probability,
+                    s.is_transmission,
+                ))
+            }
+            Strategy::Cosine => None,
+        }
+    }
+}
+
+/// What a sheen of `colour` leaves to the layers beneath it: `KHR_materials_sheen`'s
+/// albedo scaling 1 − max(colour)·E(μo), with the white sheen's albedo from the tables.
+fn sheen_transmitted(colour: Vec3, roughness: f32, mu_o: f32) -> Vec3 {
+    let e = albedo::tables().sheen(mu_o, roughness);
+    Vec3::splat((1.0 - colour.max_element() * e).max(0.0))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,167 @@
+"""Export Principled-BSDF test scenes and render their Cycles references with the materials left
+as Blender users make them (no node replaced).
+
+Run from the repository root with the PyPI `bpy` package (Blender as a Python module):
+
+    pip install bpy==5.0.1
+    python3 tools/blender/make_principled.py [--samples N] [--only NAME]
+
+For every scene this writes `tests/scenes/<name>.glb` and `.usdc` through Blender's own
+exporters, and two Cycles renders with different seeds, `tests/references/<name>_a.exr` and
+`_b.exr` (see make_references.py, whose unbiased Cycles settings it shares: box filter, no
+clamping, no denoising, 64 bounces, black world).
+
+- principled_metals: gold, steel and copper spheres at roughness 0.2, 0.5 and 0.8 on a floor and
+  a wall that keep every Principled default (roughness 0.5, a 4 % specular layer).
+- principled_plastics: glossy (0.1) and rough (0.6) plastics, a clear-coated sphere and a
+  sheen (velvet-like) sphere.
+- principled_textured: rough glass (0.2), and a metal panel whose roughness comes from a
+  texture and whose normal from a normal map.
+"""
+
+import argparse
+import math
+import os
+import sys
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import make_references  # noqa: E402  (shares Cycles settings and helpers)
+from make_cornell import export, principled, quad, reset, sphere  # noqa: E402
+from make_references import REFERENCES, SCENES, add_camera, make_image, render  # noqa: E402
+
+
+def blender_default(name, colour, **inputs):
+    """A Principled BSDF with Blender's defaults (roughness 0.5, Specular IOR Level 0.5) but
+    for the named inputs."""
+    mat = principled(name, colour, roughness=0.5, specular=0.5)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    for key, value in inputs.items():
+        bsdf.inputs[key].default_value = value
+    return mat
+
+
+def room(scene):
+    """Floor and back wall with Blender's default material, a large soft light above and a
+    small bright one to the side, both one-sided emissive quads."""
+    floor = blender_default("Floor", (0.8, 0.8, 0.8))
+    wall = blender_default("Wall", (0.5, 0.55, 0.7))
+    quad("Floor", [(-4, -4, 0), (4, -4, 0), (4, 4, 0), (-4, 4, 0)], floor)
+    quad("Wall", [(-4, 1.5, 0), (4, 1.5, 0), (4, 1.5, 4), (-4, 1.5, 4)], wall)
+    big = principled("SoftLight", (0.0, 0.0, 0.0), emission=(1.0, 0.95, 0.9), strength=4.0)
+    small = principled("KeyLight", (0.0, 0.0, 0.0), emission=(1.0, 1.0, 1.0), strength=60.0)
+    for light in (big, small):
+        light.use_backface_culling = True
+    s = 1.0
+    quad("SoftLight", [(-s, -s - 0.5, 3.5), (-s, s - 0.5, 3.5), (s, s - 0.5, 3.5), (s, -s - 0.5, 3.5)], big)
+    k = 0.15
+    # Facing the spheres from the front left, so its highlight shows on each of them.
+    quad("KeyLight", [(-2.5, -2.0 - k, 1.6 - k), (-2.5, -2.0 + k, 1.6 - k), (-2.5, -2.0 + k, 1.6 + k),
+                      (-2.5, -2.0 - k, 1.6 + k)], small)
+    add_camera(scene, (0.0, -5.0, 1.8), (0.0, 0.0, 0.5), 40.0)
+
+
+def build_metals(scene):
+    room(scene)
+    for name, colour, roughness, x in (("Gold", (1.0, 0.78, 0.34), 0.2, -1.1),
+                                       ("Steel", (0.56, 0.57, 0.58), 0.5, 0.0),
+                                       ("Copper", (0.95, 0.64, 0.54), 0.8, 1.1)):
+        mat = blender_default(name, colour, Metallic=1.0, Roughness=roughness)
+        sphere(name, mat, 0.5, (x, 0.0, 0.5))
+
+
+def build_plastics(scene):
+    room(scene)
+    glossy = blender_default("GlossyPlastic", (0.7, 0.1, 0.08), Roughness=0.1)
+    rough = blender_default("RoughPlastic", (0.1, 0.5, 0.15), Roughness=0.6)
+    coated = blender_default("Coated", (0.1, 0.2, 0.6), Roughness=0.5)
+    coated_bsdf = coated.node_tree.nodes["Principled BSDF"]
+    coated_bsdf.inputs["Coat Weight"].default_value = 1.0
+    coated_bsdf.inputs["Coat Roughness"].default_value = 0.05
+    velvet = blender_default("Velvet", (0.25, 0.05, 0.2), Roughness=0.8)
+    velvet_bsdf = velvet.node_tree.nodes["Principled BSDF"]
+    velvet_bsdf.inputs["Sheen Weight"].default_value = 1.0
+    velvet_bsdf.inputs["Sheen Roughness"].default_value = 0.5
+    for (name, mat), x in zip((("Glossy", glossy), ("Rough", rough), ("Coated", coated), ("Velvet", velvet)),
+                              (-1.5, -0.5, 0.5, 1.5)):
+        sphere(name, mat, 0.45, (x, 0.0, 0.45))
+
+
+def build_textured(scene):
+    room(scene)
+    glass = blender_default("RoughGlass", (1.0, 1.0, 1.0), Roughness=0.2)
+    glass.node_tree.nodes["Principled BSDF"].inputs["Transmission Weight"].default_value = 1.0
+    sphere("GlassBall", glass, 0.5, (-0.8, -0.3, 0.5))
+
+    def stripes(u, v):
+        # Roughness in stripes from 0.15 to 0.75 (glTF reads it from the green channel).
+        r = 0.15 + 0.6 * (int(u * 4) % 2)
+        return (1.0, r, 1.0, 1.0)
+
+    def ripples(u, v):
+        k = 2 * math.pi * 3
+        dx = 0.3 * math.cos(k * u)
+        n = (-dx, 0.0, 1.0)
+        length = math.sqrt(sum(c * c for c in n))
+        return tuple(0.5 + 0.5 * c / length for c in n) + (1.0,)
+
+    panel = blender_default("StripedMetal", (0.9, 0.9, 0.92), Metallic=1.0)
+    nodes, links = panel.node_tree.nodes, panel.node_tree.links
+    bsdf = nodes["Principled BSDF"]
+    rough_tex = nodes.new("ShaderNodeTexImage")
+    rough_tex.image = make_image("stripes", 64, stripes, "Non-Color")
+    rough_tex.interpolation = "Closest"
+    # The glTF exporter packs roughness into the green channel of metallicRoughnessTexture
+    # through a Separate Color node, as a user wires a packed texture.
+    separate = nodes.new("ShaderNodeSeparateColor")
+    links.new(rough_tex.outputs["Color"], separate.inputs["Color"])
+    links.new(separate.outputs["Green"], bsdf.inputs["Roughness"])
+    links.new(separate.outputs["Blue"], bsdf.inputs["Metallic"])
+    normal_tex = nodes.new("ShaderNodeTexImage")
+    normal_tex.image = make_image("ripples", 64, ripples, "Non-Color")
+    normal_tex.interpolation = "Closest"
+    normal_map = nodes.new("ShaderNodeNormalMap")
+    links.new(normal_tex.outputs["Color"], normal_map.inputs["Color"])
+    links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
+    obj = quad("Panel", [(0.0, 0.2, 0.05), (1.6, 0.6, 0.05), (1.6, 0.6, 1.25), (0.0, 0.2, 1.25)], panel)
+    uv = obj.data.uv_layers.new(name="UVMap")
+    for loop, coord in zip(obj.data.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
+        uv.data[loop.index].uv = coord
+
+
+# name -> (builder, total reference samples)
+SCENE_TABLE = {
+    "principled_metals": (build_metals, 1024),
+    "principled_plastics": (build_plastics, 1024),
+    "principled_textured": (build_textured, 2048),
+}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, help="total Cycles samples per pixel per scene")
+    parser.add_argument("--only", action="append", help="scene name (repeatable)")
+    parser.add_argument("--export-only", action="store_true", help="rewrite the scene files, render nothing")
+    args = parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else None)
+    os.makedirs(SCENES, exist_ok=True)
+    os.makedirs(REFERENCES, exist_ok=True)
+    for name, (build, samples) in SCENE_TABLE.items():
+        if args.only and name not in args.only:
+            continue
+        scene = reset()
+        build(scene)
+        export(os.path.join(SCENES, f"{name}.glb"))
+        path = os.path.join(SCENES, f"{name}.usdc")
+        bpy.ops.wm.usd_export(filepath=path)
+        print(f"wrote {path} ({os.path.getsize(path)} bytes)", flush=True)
+        if args.export_only:
+            continue
+        samples = args.samples or samples
+        for half, seed in (("a", 1), ("b", 2)):
+            render(scene, os.path.join(REFERENCES, f"{name}_{half}.exr"), samples // 2, seed)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
