@@ -289,7 +289,8 @@ fn inspect_lists_what_was_loaded_and_renders_nothing() {
     let report = String::from_utf8_lossy(&out.stdout);
     for expected in [
         "meshes: 6 (2228 triangles)",
-        "'Panel': diffuse, albedo (0.000, 0.000, 0.000); area light, radiance (1.800, 6.000, 2.400)",
+        "'Panel': black; base colour (0.000, 0.000, 0.000)",
+        "area light, radiance (1.800, 6.000, 2.400)",
         "one-sided",
         // 60 W at colour (1, 0.8, 0.6): 60 × 0.8 = 48 W on average over the channels.
         "'Point' (node 6 'Point'): point at (0.900, 1.600, 0.600)",

@@ -70,7 +70,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Loaded, Loa
     let mut loaded = load_by_format(path, options)?;
     for material in &loaded.scene.materials {
         let ior = material.pbr.ior;
-        if material.pbr.transmits() && !(ior.is_finite() && ior > 0.0) {
+        if !(ior.is_finite() && ior > 0.0) {
             return Err(LoadError::Invalid {
                 path: path.to_path_buf(),
                 what: format!(

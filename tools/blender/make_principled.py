@@ -109,18 +109,21 @@ def build_textured(scene):
     panel = blender_default("StripedMetal", (0.9, 0.9, 0.92), Metallic=1.0)
     nodes, links = panel.node_tree.nodes, panel.node_tree.links
     bsdf = nodes["Principled BSDF"]
-    rough_tex = nodes.new("ShaderNodeTexImage")
-    rough_tex.image = make_image("stripes", 64, stripes, "Non-Color")
-    rough_tex.interpolation = "Closest"
+
+    def data_texture(name, pixel):
+        tex = nodes.new("ShaderNodeTexImage")
+        tex.image = make_image(name, 64, pixel, "Non-Color")
+        tex.interpolation = "Closest"
+        return tex
+
+    rough_tex = data_texture("stripes", stripes)
     # The glTF exporter packs roughness into the green channel of metallicRoughnessTexture
     # through a Separate Color node, as a user wires a packed texture.
     separate = nodes.new("ShaderNodeSeparateColor")
     links.new(rough_tex.outputs["Color"], separate.inputs["Color"])
     links.new(separate.outputs["Green"], bsdf.inputs["Roughness"])
     links.new(separate.outputs["Blue"], bsdf.inputs["Metallic"])
-    normal_tex = nodes.new("ShaderNodeTexImage")
-    normal_tex.image = make_image("ripples", 64, ripples, "Non-Color")
-    normal_tex.interpolation = "Closest"
+    normal_tex = data_texture("ripples", ripples)
     normal_map = nodes.new("ShaderNodeNormalMap")
     links.new(normal_tex.outputs["Color"], normal_map.inputs["Color"])
     links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])

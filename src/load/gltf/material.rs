@@ -36,7 +36,7 @@ impl GltfLoader {
             base_colour: Vec3::new(r, g, b),
             metallic: pbr_gltf.metallic_factor(),
             roughness: pbr_gltf.roughness_factor(),
-            ior: material.ior().filter(|&ior| ior >= 1.0).unwrap_or(1.5),
+            ior: material.ior().unwrap_or(1.5),
             transmission: material
                 .transmission()
                 .map_or(0.0, |t| t.transmission_factor()),
