@@ -12,8 +12,9 @@ use crate::record::parse_range;
 /// Render a glTF 2.0 (.gltf, .glb), USD (.usd, .usda, .usdc, .usdz) or PLY scene with a
 /// physically based path tracer.
 ///
-/// Emissive materials are area lights; metallic materials are ideal mirrors; transmissive
-/// materials are ideal glass; everything else is Lambertian. Output is linear float
+/// Materials are physically based (glTF's metallic-roughness model with its specular,
+/// transmission, clear-coat and sheen extensions, which Blender's Principled BSDF and USD's
+/// UsdPreviewSurface map onto); emissive materials are area lights. Output is linear float
 /// OpenEXR (.exr) or 8-bit sRGB PNG (.png), chosen by the output file's extension.
 ///
 /// A long render can be split: `--samples A..B` renders only those samples of every pixel,

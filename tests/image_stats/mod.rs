@@ -142,6 +142,8 @@ pub fn render(
 pub struct Comparison {
     pub mean_ratio: DVec3,
     pub max_z: f64,
+    /// Block (x, y) and channel of `max_z`.
+    pub worst_block: (usize, usize, usize),
     pub rms_z: f64,
     /// Mean over blocks of |gridtrace − reference| / reference, per channel averaged.
     pub mean_block_error: f64,
@@ -152,8 +154,15 @@ pub struct Comparison {
 pub fn compare(gridtrace: &Halves, reference: &Halves) -> Comparison {
     let mean_ratio = gridtrace.image_mean() / reference.image_mean();
     let (mut max_z, mut sum_z2, mut n) = (0.0f64, 0.0f64, 0usize);
+    let mut worst_block = (0, 0, 0);
     let (mut error, mut noise, mut counted) = (0.0f64, 0.0f64, 0usize);
-    for ((g, vg), (r, vr)) in gridtrace.blocks().into_iter().zip(reference.blocks()) {
+    let per_side = SIZE / BLOCK;
+    for (b, ((g, vg), (r, vr))) in gridtrace
+        .blocks()
+        .into_iter()
+        .zip(reference.blocks())
+        .enumerate()
+    {
         for c in 0..3 {
             let sigma = (vg[c] + vr[c]).sqrt();
             let diff = g[c] - r[c];
@@ -164,7 +173,10 @@ pub fn compare(gridtrace: &Halves, reference: &Halves) -> Comparison {
             } else {
                 f64::INFINITY
             };
-            max_z = max_z.max(z.abs());
+            if z.abs() > max_z {
+                max_z = z.abs();
+                worst_block = (b % per_side, b / per_side, c);
+            }
             sum_z2 += z * z;
             n += 1;
             if r[c] > 0.0 {
@@ -177,6 +189,7 @@ pub fn compare(gridtrace: &Halves, reference: &Halves) -> Comparison {
     Comparison {
         mean_ratio,
         max_z,
+        worst_block,
         rms_z: (sum_z2 / n as f64).sqrt(),
         mean_block_error: error / counted.max(1) as f64,
         // E|N(0, σ)| = σ·√(2/π).
@@ -228,12 +241,14 @@ pub fn render_scene_halves(scene: &gridtrace::scene::Scene, spp: u32, first_seed
 fn describe(what: &str, c: &Comparison, blocks_note: &str) -> String {
     format!(
         "{what}: mean ratio R {:.4} G {:.4} B {:.4}; \
-         {BLOCK}×{BLOCK} blocks{blocks_note}: max |z| {:.2}, rms z {:.2}, mean relative error \
-         {:.4} (noise alone: {:.4})",
+         {BLOCK}×{BLOCK} blocks{blocks_note}: max |z| {:.2} (block {:?}, channel {}), rms z {:.2}, \
+         mean relative error {:.4} (noise alone: {:.4})",
         c.mean_ratio.x,
         c.mean_ratio.y,
         c.mean_ratio.z,
         c.max_z,
+        (c.worst_block.0, c.worst_block.1),
+        c.worst_block.2,
         c.rms_z,
         c.mean_block_error,
         c.mean_block_noise,
@@ -267,7 +282,12 @@ pub fn check_agreement(what: &str, ours: &Halves, theirs: &Halves) {
 pub fn check_image_means(what: &str, ours: &Halves, theirs: &Halves) {
     let c = compare(ours, theirs);
     let report = describe(what, &c, " (not checked)");
-    println!("{report}");
+    let name: String = what
+        .chars()
+        .map(|c| if c.is_alphanumeric() { c } else { '_' })
+        .collect();
+    let dir = write_difference_images(&name, ours, theirs);
+    println!("{report}; images in {}", dir.display());
     assert!(
         (c.mean_ratio - DVec3::ONE).abs().max_element() < MAX_MEAN_ERROR,
         "{report}\nlimit: every channel's image mean within {MAX_MEAN_ERROR}"

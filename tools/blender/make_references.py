@@ -10,9 +10,11 @@ For every scene this writes the glTF file gridtrace renders (the bundled Cornell
 `tests/references/<name>_a.exr` and `_b.exr`, each with half the samples. Their mean is the
 reference; their difference measures the reference's own noise (tests/reference_images.rs).
 
-Before rendering, every Principled BSDF is replaced by the node that is exactly gridtrace's model
-of it (the README's material table): a Diffuse BSDF (Lambertian), a sharp Glossy BSDF (ideal
-mirror, no Fresnel), a sharp Glass BSDF (ideal dielectric), plus an Emission node for emitters.
+Before rendering, every Principled BSDF is replaced by the node that is gridtrace's model of it:
+a Diffuse BSDF (Lambertian: the scenes' Principled BSDFs set Specular IOR Level 0, exported as
+KHR_materials_specular.specularFactor 0), a sharp Glossy BSDF (ideal mirror; gridtrace adds
+Schlick's Fresnel, a rim difference of at most (1 - F0)(1 - cos)^5), a sharp Glass BSDF (ideal
+dielectric), plus an Emission node for emitters.
 Cycles runs unbiased: box pixel filter one pixel wide, no clamping, no denoising, no adaptive
 sampling, no glossy filter, caustics on, 64 bounces, black world.
 """

@@ -1,18 +1,16 @@
 //! Directional albedo tables: how much of the light arriving from a direction a lobe
-//! reflects, E(μ) = ∫ f(wo, wi) cos θi dωi, and its cosine-weighted average Ē = ∫ 2μ E(μ) dμ.
-//! Energy compensation (Kulla & Conty 2017, "Revisiting physically based shading at
-//! Imageworks") and the layering of lobes over one another are built from them.
+//! reflects, E(μ) = ∫ f(wo, wi) cos θi dωi. Energy compensation (Turquin 2019) and the
+//! layering of lobes over one another are built from them.
 //!
 //! The tables are integrated once per process, on first use, with stratified samples of the
 //! lobes' own sampling routines (a few milliseconds), so they always describe exactly the
-//! lobes that are rendered. Between grid points they are linear in μ and in roughness, and
-//! the averages are the exact integrals of that interpolation, so Ē and E always agree.
+//! lobes that are rendered. Between grid points they are linear in μ and in roughness.
 
 use std::sync::OnceLock;
 
 use glam::{Vec2, Vec3};
 
-use super::fresnel::schlick_weight;
+use super::fresnel::{fresnel_dielectric, refract, schlick_weight};
 use super::microfacet::{DELTA_ALPHA, Ggx, reflect};
 use super::sheen::{SHEEN_MIN_ALPHA, charlie_brdf};
 
@@ -27,8 +25,8 @@ pub struct AlbedoTables {
     /// Split-sum terms of GGX with Schlick's Fresnel: E(μ) = F0·A + F90·B. Index
     /// `roughness · N + μ`.
     schlick: Vec<Vec2>,
-    /// Cosine-weighted averages of A and B per roughness.
-    schlick_average: Vec<Vec2>,
+    /// Cosine-weighted average of the albedo with F = 1, Ē = ∫ 2μ (A + B) dμ, per roughness.
+    white_average: Vec<f32>,
     /// Albedo of the Charlie sheen lobe with a white sheen colour.
     sheen: Vec<f32>,
 }
@@ -56,12 +54,12 @@ impl AlbedoTables {
                 sheen.push(integrate_sheen(sheen_alpha, wo));
             }
         }
-        let schlick_average = (0..N)
-            .map(|j| cosine_average(|i| schlick[j * N + i]))
+        let white_average = (0..N)
+            .map(|j| cosine_average(|i| schlick[j * N + i]).element_sum())
             .collect();
         AlbedoTables {
             schlick,
-            schlick_average,
+            white_average,
             sheen,
         }
     }
@@ -71,9 +69,9 @@ impl AlbedoTables {
         bilinear(&self.schlick, mu, roughness)
     }
 
-    /// Cosine-weighted averages (Ā, B̄) at `roughness`.
-    pub fn schlick_average(&self, roughness: f32) -> Vec2 {
-        linear(&self.schlick_average, roughness)
+    /// Ē at `roughness`: the cosine-weighted average albedo of GGX with F = 1.
+    pub fn white_average(&self, roughness: f32) -> f32 {
+        linear(&self.white_average, roughness)
     }
 
     /// Albedo of the white Charlie sheen at (μ, roughness).
@@ -132,6 +130,134 @@ fn integrate_sheen(alpha: f32, wo: Vec3) -> f32 {
     sum * 2.0 * std::f32::consts::PI / (S * PHI) as f32
 }
 
+/// Grid points per axis of the glass table (μ, roughness, index of refraction).
+const GLASS_N: usize = 16;
+
+/// Largest index of refraction in the glass table (diamond is 2.42).
+const GLASS_MAX_IOR: f32 = 3.0;
+
+/// Albedos of a rough dielectric interface per (side, ior, roughness, μ), before
+/// compensation: x = reflection alone (the specular layer and the coat), y = reflection plus
+/// transmission in energy (glass). Side 0: light arrives from the lower index (η = ior),
+/// side 1: from the higher (η = 1/ior).
+pub struct GlassTable {
+    values: Vec<Vec2>,
+    /// Cosine-weighted average of the exact Fresnel reflectance per ior, from outside.
+    fresnel_average: Vec<f32>,
+}
+
+/// The process's glass table, integrated on first use by a rough glass.
+pub fn glass_table() -> &'static GlassTable {
+    static TABLE: OnceLock<GlassTable> = OnceLock::new();
+    TABLE.get_or_init(GlassTable::integrate)
+}
+
+impl GlassTable {
+    fn integrate() -> GlassTable {
+        let grid = |i: usize| i as f32 / (GLASS_N - 1) as f32;
+        let mut values = Vec::with_capacity(2 * GLASS_N * GLASS_N * GLASS_N);
+        for side in 0..2 {
+            for k in 0..GLASS_N {
+                let ior = 1.0 + (GLASS_MAX_IOR - 1.0) * grid(k);
+                let eta = if side == 0 { ior } else { 1.0 / ior };
+                for j in 0..GLASS_N {
+                    let roughness = grid(j);
+                    let ggx = Ggx {
+                        alpha: (roughness * roughness).max(DELTA_ALPHA),
+                    };
+                    for i in 0..GLASS_N {
+                        let mu = grid(i).max(1e-3);
+                        let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+                        values.push(integrate_glass(&ggx, eta, wo));
+                    }
+                }
+            }
+        }
+        let fresnel_average = (0..GLASS_N)
+            .map(|k| {
+                let ior = 1.0 + (GLASS_MAX_IOR - 1.0) * grid(k);
+                let n = 512;
+                (0..n)
+                    .map(|i| {
+                        let mu = (i as f32 + 0.5) / n as f32;
+                        2.0 * mu * fresnel_dielectric(mu, 1.0 / ior)
+                    })
+                    .sum::<f32>()
+                    / n as f32
+            })
+            .collect();
+        GlassTable {
+            values,
+            fresnel_average,
+        }
+    }
+
+    /// The cosine-weighted average of the exact Fresnel reflectance of index `ior` seen
+    /// from outside.
+    pub fn fresnel_average(&self, ior: f32) -> f32 {
+        let (k, t) = position_in((ior - 1.0) / (GLASS_MAX_IOR - 1.0), GLASS_N);
+        self.fresnel_average[k] * (1.0 - t) + self.fresnel_average[k + 1] * t
+    }
+
+    /// The energy albedo of glass at `mu` for roughness `roughness` and relative index
+    /// `eta` (η_other / η_wo): reflection plus transmission.
+    pub fn albedo(&self, mu: f32, roughness: f32, eta: f32) -> f32 {
+        self.lookup(mu, roughness, eta).y
+    }
+
+    /// The albedo of reflection alone (exact Fresnel) off a dielectric of index `eta` ≥ 1
+    /// seen from outside.
+    pub fn reflection(&self, mu: f32, roughness: f32, eta: f32) -> f32 {
+        self.lookup(mu, roughness, eta.max(1.0)).x
+    }
+
+    /// Both albedos, trilinear between grid points.
+    fn lookup(&self, mu: f32, roughness: f32, eta: f32) -> Vec2 {
+        let (side, ior) = if eta >= 1.0 { (0, eta) } else { (1, 1.0 / eta) };
+        let (k, tk) = position_in((ior - 1.0) / (GLASS_MAX_IOR - 1.0), GLASS_N);
+        let (j, tj) = position_in(roughness, GLASS_N);
+        let (i, ti) = position_in(mu, GLASS_N);
+        let at = |k: usize, j: usize, i: usize| {
+            self.values[((side * GLASS_N + k) * GLASS_N + j) * GLASS_N + i]
+        };
+        let mut sum = Vec2::ZERO;
+        for (dk, wk) in [(0, 1.0 - tk), (1, tk)] {
+            for (dj, wj) in [(0, 1.0 - tj), (1, tj)] {
+                for (di, wi) in [(0, 1.0 - ti), (1, ti)] {
+                    sum += wk * wj * wi * at(k + dk, j + dj, i + di);
+                }
+            }
+        }
+        sum
+    }
+}
+
+/// Reflection and refraction through each stratified visible normal, both branches weighed
+/// by their Fresnel share (no random choice): G2/G1 per valid direction (Heitz 2018).
+fn integrate_glass(ggx: &Ggx, eta: f32, wo: Vec3) -> Vec2 {
+    const S: usize = 12;
+    let mut reflection = 0.0;
+    let mut transmission = 0.0;
+    for k in 0..S * S {
+        let u = Vec2::new(
+            ((k % S) as f32 + 0.5) / S as f32,
+            ((k / S) as f32 + 0.5) / S as f32,
+        );
+        let h = ggx.sample_visible(wo, u);
+        let f = fresnel_dielectric(wo.dot(h), 1.0 / eta);
+        let wr = reflect(wo, h);
+        if wr.z > 0.0 {
+            reflection += f * ggx.g2(wo, wr) / ggx.g1(wo);
+        }
+        if let Some(wt) = refract(wo, h, 1.0 / eta)
+            && wt.z < 0.0
+        {
+            transmission += (1.0 - f) * ggx.g2(wo, wt) / ggx.g1(wo);
+        }
+    }
+    Vec2::new(reflection, reflection + transmission) / (S * S) as f32
+}
+
 /// ∫ 2μ E(μ) dμ of the piecewise-linear E through the grid values, exactly: on [a, b] the
 /// integral of 2μ·(eₐ + (e_b − eₐ)(μ − a)/(b − a)) is (b − a)·(eₐ(2a + b) + e_b(a + 2b))/3.
 fn cosine_average(value: impl Fn(usize) -> Vec2) -> Vec2 {
@@ -144,8 +270,13 @@ fn cosine_average(value: impl Fn(usize) -> Vec2) -> Vec2 {
 }
 
 fn position(x: f32) -> (usize, f32) {
-    let x = x.clamp(0.0, 1.0) * (N - 1) as f32;
-    let i = (x as usize).min(N - 2);
+    position_in(x, N)
+}
+
+/// Index and fraction of `x` ∈ [0, 1] on a grid of `n` points.
+fn position_in(x: f32, n: usize) -> (usize, f32) {
+    let x = x.clamp(0.0, 1.0) * (n - 1) as f32;
+    let i = (x as usize).min(n - 2);
     (i, x - i as f32)
 }
 
@@ -179,7 +310,7 @@ mod tests {
         assert!((e(1.0, 0.05) - 1.0).abs() < 0.01, "{}", e(1.0, 0.05));
         assert!(e(1.0, 0.5) < 0.95 && e(1.0, 0.5) > 0.85, "{}", e(1.0, 0.5));
         assert!(e(1.0, 1.0) > 0.25 && e(1.0, 1.0) < 0.4, "{}", e(1.0, 1.0));
-        let avg = |r| t.schlick_average(r).element_sum();
+        let avg = |r| t.white_average(r);
         assert!(avg(1.0) > 0.35 && avg(1.0) < 0.5, "{}", avg(1.0));
         assert!(avg(0.2) > avg(0.5) && avg(0.5) > avg(1.0));
         // Schlick's grazing term B is what F90 weighs: large only near grazing incidence.

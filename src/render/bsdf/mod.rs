@@ -3,7 +3,7 @@
 //! has and how they stack (glTF 2.0 Appendix B and its KHR material extensions):
 //!
 //! ```text
-//! coat  ─ clear GGX dielectric (F0 0.04 · clearcoat)
+//! coat  ─ clear GGX dielectric (index 1.5, exact Fresnel × clearcoat)
 //!  └ sheen ─ Charlie sheen
 //!     └ metallic · GGX conductor (F0 = base colour)
 //!       + (1 − metallic)(1 − transmission) · [GGX dielectric layer over Lambertian base]
@@ -35,12 +35,21 @@ use glam::{Vec2, Vec3};
 
 use super::sampling::{Frame, cosine_hemisphere};
 use crate::scene::{Pbr, f0_of_ior};
+use fresnel::Fresnel;
 use glass::GlassLobe;
 use sheen::charlie_brdf;
 use specular::SpecularLobe;
 
-/// F0 of the clear coat: a dielectric of index 1.5, as `KHR_materials_clearcoat` fixes it.
-const COAT_F0: f32 = 0.04;
+/// Index of the clear coat: 1.5, as `KHR_materials_clearcoat` fixes it (F0 = 0.04) and as
+/// Cycles' coat defaults.
+const COAT_IOR: f32 = 1.5;
+
+/// The index of refraction whose normal-incidence reflectance is `f0` < 1 (the inverse of
+/// [`f0_of_ior`]).
+fn ior_of_f0(f0: f32) -> f32 {
+    let r = f0.clamp(0.0, 0.99).sqrt();
+    (1.0 + r) / (1.0 - r)
+}
 
 /// The lobes of one material at one point, with their weights.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,7 +88,7 @@ pub struct BsdfSample {
 /// The ways [`Bsdf::sample`] draws a direction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Strategy {
-    /// Cosine-weighted: the diffuse base, the sheen and the multiple-scattering lobes.
+    /// Cosine-weighted: the diffuse base and the sheen.
     Cosine,
     Coat,
     Metal,
@@ -105,23 +114,33 @@ impl Bsdf {
         let dielectric = (1.0 - metallic) * (1.0 - transmission);
         let base = pbr.base_colour.clamp(Vec3::ZERO, Vec3::ONE);
         let positive = |w: f32| (w > 0.0).then_some(w);
-        let strength = pbr.specular.clamp(0.0, 1.0);
-        let specular = positive(dielectric * strength).map(|_| {
-            // KHR_materials_specular: F0 = min(F0(ior)·specularColour, 1)·specular and
-            // F90 = specular.
-            let f0 = (f0_of_ior(pbr.ior) * pbr.specular_colour).min(Vec3::ONE) * strength;
-            (SpecularLobe::new(roughness, f0, strength), dielectric)
+        // KHR_materials_specular's F0 = min(F0(ior)·specularColour, 1)·specular, reached as
+        // Cycles reaches its "Specular IOR Level": on the exact Fresnel curve of the index
+        // whose F0 is the largest channel's, so that reflection still rises to 1 at grazing
+        // angles, the other channels scaled down.
+        let f0 = (f0_of_ior(pbr.ior) * pbr.specular_colour.max(Vec3::ZERO)).min(Vec3::ONE)
+            * pbr.specular.clamp(0.0, 1.0);
+        let peak = f0.max_element().min(0.99);
+        let specular = positive(dielectric).filter(|_| peak > 0.0).map(|w| {
+            let fresnel = Fresnel::Dielectric {
+                eta: ior_of_f0(peak),
+                scale: (f0 / peak).min(Vec3::ONE),
+            };
+            (SpecularLobe::new(roughness, fresnel), w)
         });
-        let metal = positive(metallic).map(|w| (SpecularLobe::new(roughness, base, 1.0), w));
+        let metal = positive(metallic).map(|w| {
+            let fresnel = Fresnel::Schlick { f0: base, f90: 1.0 };
+            (SpecularLobe::new(roughness, fresnel), w)
+        });
         let eta = if front { pbr.ior } else { 1.0 / pbr.ior };
         let glass = positive((1.0 - metallic) * transmission)
             .map(|w| (GlassLobe::new(roughness, eta, base), w));
         let coat = positive(pbr.clearcoat.min(1.0)).map(|c| {
-            SpecularLobe::new(
-                pbr.clearcoat_roughness.clamp(0.0, 1.0),
-                Vec3::splat(COAT_F0 * c),
-                c,
-            )
+            let fresnel = Fresnel::Dielectric {
+                eta: COAT_IOR,
+                scale: Vec3::splat(c),
+            };
+            SpecularLobe::new(pbr.clearcoat_roughness.clamp(0.0, 1.0), fresnel)
         });
         let sheen = (pbr.sheen_colour.max_element() > 0.0).then(|| {
             (
@@ -246,26 +265,23 @@ impl Bsdf {
         let mut coat = 0.0;
         let mut cosine = 0.0;
         if let Some(c) = &self.coat {
-            coat = mean(c.single_albedo(mu_o));
-            cosine += mean(c.albedo(mu_o)) - coat;
-            top = 1.0 - mean(c.albedo(mu_o));
+            coat = mean(c.albedo(mu_o));
+            top = 1.0 - coat;
         }
         if let Some((colour, roughness)) = self.sheen {
             let e = colour.max_element() * albedo::tables().sheen(mu_o, roughness);
             cosine += top * e;
             top *= 1.0 - e;
         }
-        let mut metal = 0.0;
-        if let Some((m, w)) = &self.metal {
-            metal = top * w * mean(m.single_albedo(mu_o));
-            cosine += top * w * mean(m.albedo(mu_o) - m.single_albedo(mu_o));
-        }
+        let metal = self
+            .metal
+            .map_or(0.0, |(m, w)| top * w * mean(m.albedo(mu_o)));
         let mut specular = 0.0;
         let mut under = Vec3::ONE;
         if let Some((s, w)) = &self.specular {
-            specular = top * w * mean(s.single_albedo(mu_o));
-            cosine += top * w * mean(s.albedo(mu_o) - s.single_albedo(mu_o));
-            under = Vec3::ONE - s.albedo(mu_o);
+            let e = s.albedo(mu_o);
+            specular = top * w * mean(e);
+            under = Vec3::ONE - e;
         }
         cosine += top * mean(self.diffuse * under);
         // Glass passes or reflects almost everything, whatever its tint.
