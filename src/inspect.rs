@@ -103,13 +103,11 @@ fn material_summary(m: &Material, emitted: f32) -> String {
         significant(p.roughness),
         significant(p.ior)
     );
-    if p.specular != 1.0 || p.specular_colour != Vec3::ONE {
-        let _ = write!(
-            s,
-            ", specular {} tint {}",
-            significant(p.specular),
-            vector(p.specular_colour)
-        );
+    if p.specular != 1.0 {
+        let _ = write!(s, ", specular {}", significant(p.specular));
+    }
+    if p.specular_colour != Vec3::ONE {
+        let _ = write!(s, ", specular tint {}", vector(p.specular_colour));
     }
     if p.transmission > 0.0 {
         let _ = write!(s, ", transmission {}", significant(p.transmission));

@@ -90,6 +90,9 @@ pub struct Renderer<'a> {
     frames: Vec<InstanceFrame>,
     /// True when some material has alpha cutouts or blending, so hits must be checked.
     has_cutouts: bool,
+    /// Each material's BSDF for rays arriving on its front and on its back side, made once
+    /// (materials that textures vary are made again at each hit).
+    bsdfs: Vec<[Bsdf; 2]>,
 }
 
 impl<'a> Renderer<'a> {
@@ -101,6 +104,11 @@ impl<'a> Renderer<'a> {
             lights: LightSet::build(scene),
             frames: InstanceFrame::for_scene(scene),
             has_cutouts: scene.materials.iter().any(|m| m.is_cutout()),
+            bsdfs: scene
+                .materials
+                .iter()
+                .map(|m| [Bsdf::new(&m.pbr, true), Bsdf::new(&m.pbr, false)])
+                .collect(),
         }
     }
 

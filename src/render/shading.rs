@@ -57,7 +57,7 @@ impl Renderer<'_> {
         let material = &self.scene.materials[s.material];
         if !material.varies() {
             return Shading {
-                bsdf: Bsdf::new(&material.pbr, front),
+                bsdf: self.bsdfs[s.material][usize::from(!front)],
                 emission: material.emission,
                 normal: s.shading_normal,
             };

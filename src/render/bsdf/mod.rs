@@ -201,6 +201,16 @@ impl Bsdf {
             && self.glass.is_none_or(|(g, _)| g.is_delta())
     }
 
+    /// True when the only lobe is the Lambertian base: the common case, which needs no
+    /// local frame and no strategy weights.
+    fn is_lambertian(&self) -> bool {
+        self.specular.is_none()
+            && self.metal.is_none()
+            && self.glass.is_none()
+            && self.coat.is_none()
+            && self.sheen.is_none()
+    }
+
     fn has_cosine_lobes(&self) -> bool {
         self.diffuse.max_element() > 0.0
             || self.sheen.is_some()
@@ -314,12 +324,28 @@ impl Bsdf {
 
     /// f(wo, wi) over the non-delta lobes; zero for delta lobes.
     pub fn eval(&self, n: Vec3, wo: Vec3, wi: Vec3) -> Vec3 {
+        if self.is_lambertian() {
+            let above = n.dot(wo) > 0.0 && n.dot(wi) > 0.0;
+            return if above {
+                self.diffuse * FRAC_1_PI
+            } else {
+                Vec3::ZERO
+            };
+        }
         let frame = Frame::from_normal(n);
         self.eval_local(frame.to_local(wo), frame.to_local(wi))
     }
 
     /// Solid-angle pdf with which [`Bsdf::sample`] picks `wi` by its non-delta strategies.
     pub fn pdf(&self, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
+        if self.is_lambertian() {
+            let black = self.diffuse == Vec3::ZERO || n.dot(wo) <= 0.0;
+            return if black {
+                0.0
+            } else {
+                n.dot(wi).max(0.0) * FRAC_1_PI
+            };
+        }
         let frame = Frame::from_normal(n);
         let wo = frame.to_local(wo);
         let weights = self.strategy_weights(wo.z);
@@ -333,6 +359,18 @@ impl Bsdf {
         let wo = frame.to_local(wo);
         if wo.z <= 0.0 {
             return None;
+        }
+        if self.is_lambertian() {
+            let wi = cosine_hemisphere(u);
+            let pdf = wi.z * FRAC_1_PI;
+            return (pdf > 0.0 && self.diffuse != Vec3::ZERO).then(|| BsdfSample {
+                wi: frame.to_world(wi),
+                weight: self.diffuse,
+                pdf,
+                is_delta: false,
+                is_transmission: false,
+                eta_scale: 1.0,
+            });
         }
         let weights = self.strategy_weights(wo.z);
         let total: f32 = weights.iter().sum();
