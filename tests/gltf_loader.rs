@@ -537,3 +537,37 @@ fn the_files_beside_a_gltf_are_listed() {
         .collect();
     assert_eq!(names, ["quad.bin", "wood.png"]);
 }
+
+/// The KHR material extensions Blender writes for Principled inputs land in the material
+/// description; textures not read yet are named in one warning each.
+#[test]
+fn principled_extensions_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = quad_document();
+    doc["extensionsUsed"] = json!([
+        "KHR_materials_specular",
+        "KHR_materials_clearcoat",
+        "KHR_materials_sheen"
+    ]);
+    doc["materials"] = json!([
+        {"name": "car paint", "pbrMetallicRoughness": {"metallicFactor": 0.2, "roughnessFactor": 0.35},
+         "extensions": {
+            "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [2.0, 1.0, 1.0]},
+            "KHR_materials_clearcoat": {"clearcoatFactor": 0.7, "clearcoatRoughnessFactor": 0.1,
+                                        "clearcoatNormalTexture": {"index": 0}},
+            "KHR_materials_sheen": {"sheenColorFactor": [1.0, 0.5, 0.2], "sheenRoughnessFactor": 0.4}
+         }}
+    ]);
+    doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let loaded = load_scene(&write_gltf(dir.path(), "p.gltf", &doc)).unwrap();
+    assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+    assert!(loaded.warnings[0].contains("clearcoatNormalTexture is not read"));
+    let p = loaded.scene.materials[0].pbr;
+    assert_eq!((p.metallic, p.roughness), (0.2, 0.35));
+    assert_eq!(
+        (p.specular, p.specular_colour),
+        (0.5, Vec3::new(2.0, 1.0, 1.0))
+    );
+    assert!((p.clearcoat - 0.7).abs() < 1e-6 && (p.clearcoat_roughness - 0.1).abs() < 1e-6);
+    assert!(p.sheen_colour == Vec3::new(1.0, 0.5, 0.2) && (p.sheen_roughness - 0.4).abs() < 1e-6);
+}

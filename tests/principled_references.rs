@@ -44,9 +44,21 @@ fn plastics_and_coat_from_usd_match_cycles() {
     check("principled_plastics", "usdc", SPP);
 }
 
-/// Rough glass, and a metal whose roughness and normal come from textures. glTF only:
-/// Blender's USD exporter writes no transmission.
+/// A metal whose roughness (and metallic) come from a packed texture and whose normal from
+/// a normal map.
 #[test]
-fn rough_glass_and_roughness_texture_match_cycles() {
-    check("principled_textured", "glb", 2 * SPP);
+fn roughness_texture_and_normal_map_match_cycles() {
+    check("principled_textured", "glb", SPP);
+}
+
+#[test]
+fn roughness_texture_and_normal_map_from_usd_match_cycles() {
+    check("principled_textured", "usdc", SPP);
+}
+
+/// Rough glass (0.2), lit through it onto the floor. glTF only: Blender's USD exporter
+/// writes no transmission.
+#[test]
+fn rough_glass_matches_cycles() {
+    check("principled_glass", "glb", 2 * SPP);
 }

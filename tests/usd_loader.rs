@@ -856,3 +856,101 @@ fn blender_animation_is_read_at_each_frame() {
         );
     }
 }
+
+/// UsdPreviewSurface inputs as the README's material table maps them: the specular
+/// workflow's F0, Blender's `specular` level, clear coat, and scalar inputs read from one
+/// channel of a texture with that channel's `scale`.
+#[test]
+fn preview_surface_inputs_map_to_the_material_description() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 128, 0, 255]))
+        .save(dir.path().join("packed.png"))
+        .unwrap();
+    let material = |name: &str, inputs: &str| {
+        format!(
+            r#"
+        def Material "{name}"
+        {{
+            token outputs:surface.connect = </World/Looks/{name}/Surface.outputs:surface>
+            def Shader "Surface"
+            {{
+                uniform token info:id = "UsdPreviewSurface"
+                {inputs}
+                token outputs:surface
+            }}
+            def Shader "Packed"
+            {{
+                uniform token info:id = "UsdUVTexture"
+                asset inputs:file = @packed.png@
+                float4 inputs:scale = (1, 0.5, 1, 1)
+                float outputs:g
+                float outputs:b
+            }}
+        }}"#
+        )
+    };
+    let mesh = |name: &str, look: &str, x: i32| {
+        format!(
+            r#"
+    def Mesh "{name}"
+    {{
+        int[] faceVertexCounts = [3]
+        int[] faceVertexIndices = [0, 1, 2]
+        point3f[] points = [({x}, 0, 0), ({x}.5, 0, 0), ({x}, 1, 0)]
+        rel material:binding = </World/Looks/{look}>
+    }}"#
+        )
+    };
+    let stage = format!(
+        "#usda 1.0\n(\n    defaultPrim = \"World\"\n    upAxis = \"Y\"\n    metersPerUnit = 1\n)\n\
+         def Xform \"World\"\n{{{}{}{}\n    def Scope \"Looks\"\n    {{{}{}{}\n    }}\n}}\n",
+        mesh("A", "Specular", 0),
+        mesh("B", "Blender", 2),
+        mesh("C", "Textured", 4),
+        material(
+            "Specular",
+            "int inputs:useSpecularWorkflow = 1\n                color3f inputs:specularColor = (0.1, 0.2, 0.3)\n                float inputs:clearcoat = 0.5\n                float inputs:clearcoatRoughness = 0.2"
+        ),
+        material(
+            "Blender",
+            "float inputs:specular = 0.25\n                float inputs:metallic = 0.3"
+        ),
+        material(
+            "Textured",
+            "float inputs:roughness.connect = </World/Looks/Textured/Packed.outputs:g>\n                float inputs:metallic.connect = </World/Looks/Textured/Packed.outputs:b>"
+        ),
+    );
+    let path = dir.path().join("looks.usda");
+    std::fs::write(&path, stage).unwrap();
+    let loaded = load_scene(&path).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let find = |name: &str| {
+        loaded
+            .scene
+            .materials
+            .iter()
+            .find(|m| m.name == format!("/World/Looks/{name}"))
+            .unwrap_or_else(|| panic!("{name}"))
+            .clone()
+    };
+    let specular = find("Specular").pbr;
+    // F0 = min(F0(ior)·specularColour, 1)·specular is the authored specularColor.
+    let f0 =
+        gridtrace::scene::f0_of_ior(specular.ior) * specular.specular_colour * specular.specular;
+    assert!(
+        (f0 - Vec3::new(0.1, 0.2, 0.3)).abs().max_element() < 1e-5,
+        "{f0}"
+    );
+    assert_eq!(specular.metallic, 0.0);
+    assert!(specular.clearcoat == 0.5 && (specular.clearcoat_roughness - 0.2).abs() < 1e-6);
+    // Blender's level 0.25 halves F0: specular 0.5 with an untinted colour.
+    let blender = find("Blender").pbr;
+    assert!((blender.specular - 0.5).abs() < 1e-6 && blender.specular_colour == Vec3::ONE);
+    assert!((blender.metallic - 0.3).abs() < 1e-6);
+    // Texture channels: roughness from green with its scale 0.5, metallic from blue.
+    let textured = find("Textured");
+    let roughness = textured.textures.roughness.expect("roughness texture");
+    let metallic = textured.textures.metallic.expect("metallic texture");
+    assert_eq!((roughness.channel, metallic.channel), (1, 2));
+    assert!((textured.pbr.roughness - 0.5).abs() < 1e-6 && textured.pbr.metallic == 1.0);
+}

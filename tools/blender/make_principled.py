@@ -16,8 +16,10 @@ clamping, no denoising, 64 bounces, black world).
 - principled_plastics: glossy (0.1) and rough (0.6) plastics and a clear-coated sphere.
   (Sheen is not compared: Cycles' Principled sheen is its "microfiber" model, glTF's
   KHR_materials_sheen is Charlie's, which gridtrace follows; see the README.)
-- principled_textured: rough glass (0.2), and a metal panel whose roughness comes from a
-  texture and whose normal from a normal map.
+- principled_textured: a metal panel whose roughness comes from a texture and whose normal from
+  a normal map.
+- principled_glass: a rough glass ball (0.2). Blender's USD exporter writes no transmission, so
+  its .usdc has an opaque ball and is not compared.
 """
 
 import argparse
@@ -84,11 +86,15 @@ def build_plastics(scene):
         sphere(name, mat, 0.5, (x, 0.0, 0.5))
 
 
-def build_textured(scene):
+def build_glass(scene):
     room(scene)
     glass = blender_default("RoughGlass", (1.0, 1.0, 1.0), Roughness=0.2)
     glass.node_tree.nodes["Principled BSDF"].inputs["Transmission Weight"].default_value = 1.0
-    sphere("GlassBall", glass, 0.5, (-0.8, -0.3, 0.5))
+    sphere("GlassBall", glass, 0.5, (-0.3, -0.3, 0.5))
+
+
+def build_textured(scene):
+    room(scene)
 
     def stripes(u, v):
         # Roughness in stripes from 0.15 to 0.75 (glTF reads it from the green channel).
@@ -123,7 +129,7 @@ def build_textured(scene):
     normal_map = nodes.new("ShaderNodeNormalMap")
     links.new(normal_tex.outputs["Color"], normal_map.inputs["Color"])
     links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
-    obj = quad("Panel", [(0.0, 0.2, 0.05), (1.6, 0.6, 0.05), (1.6, 0.6, 1.25), (0.0, 0.2, 1.25)], panel)
+    obj = quad("Panel", [(-0.9, 0.0, 0.05), (0.9, 0.4, 0.05), (0.9, 0.4, 1.45), (-0.9, 0.0, 1.45)], panel)
     uv = obj.data.uv_layers.new(name="UVMap")
     for loop, coord in zip(obj.data.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
         uv.data[loop.index].uv = coord
@@ -133,7 +139,8 @@ def build_textured(scene):
 SCENE_TABLE = {
     "principled_metals": (build_metals, 2048),
     "principled_plastics": (build_plastics, 2048),
-    "principled_textured": (build_textured, 4096),
+    "principled_textured": (build_textured, 2048),
+    "principled_glass": (build_glass, 4096),
 }
 
 
