@@ -97,8 +97,10 @@ def build_textured(scene):
     room(scene)
 
     def stripes(u, v):
-        # Roughness in stripes from 0.15 to 0.75 (glTF reads it from the green channel).
-        r = 0.15 + 0.6 * (int(u * 4) % 2)
+        # Roughness in smooth bands from 0.15 to 0.75 (glTF reads it from the green channel).
+        # Smooth, because Blender's USD export cannot say "Closest": the .usdc is filtered
+        # bilinearly, the .glb (magFilter NEAREST) and Cycles are not.
+        r = 0.45 - 0.3 * math.cos(2 * math.pi * 2 * u)
         return (1.0, r, 1.0, 1.0)
 
     def ripples(u, v):
@@ -159,7 +161,8 @@ def main():
         build(scene)
         export(os.path.join(SCENES, f"{name}.glb"))
         path = os.path.join(SCENES, f"{name}.usdc")
-        bpy.ops.wm.usd_export(filepath=path)
+        # Textures are written beside the layer; replace any left by an earlier run.
+        bpy.ops.wm.usd_export(filepath=path, overwrite_textures=True)
         print(f"wrote {path} ({os.path.getsize(path)} bytes)", flush=True)
         if args.export_only:
             continue
