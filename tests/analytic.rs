@@ -661,3 +661,81 @@ fn a_diffuse_sphere_under_a_uniform_sky_shows_albedo_times_sky() {
         assert_eq!(mean, sky.as_dvec3(), "{strategy:?}");
     }
 }
+
+/// A clear coat's own normal map (`clearcoatNormalTexture`) tilts the coat alone: a smooth
+/// coat over a black base under a uniform sky shows F(wo·n′)·L_sky, with n′ the mapped coat
+/// normal and F the exact Fresnel reflectance of index 1.5 — not F(wo·n).
+#[test]
+fn a_coat_normal_map_tilts_the_coat() {
+    let sky = Vec3::new(1.0, 2.0, 0.5);
+    let tilt = 30f32.to_radians();
+    let mapped = Vec3::new(tilt.sin(), 0.0, tilt.cos());
+    let mut b = SceneBuilder::new();
+    let floor = b.add_material(Material::new(
+        "coat",
+        Pbr {
+            base_colour: Vec3::ZERO,
+            metallic: 0.0,
+            specular: 0.0,
+            clearcoat: 1.0,
+            clearcoat_roughness: 0.0,
+            ..Pbr::default()
+        },
+    ));
+    let v = Vec3::new;
+    let mesh = b.add_mesh(
+        "floor",
+        vec![
+            v(-5., 0., -5.),
+            v(-5., 0., 5.),
+            v(5., 0., 5.),
+            v(5., 0., -5.),
+        ],
+        vec![[0, 1, 2], [0, 2, 3]],
+        floor,
+    );
+    b.add_instance(mesh, Affine3A::IDENTITY, "floor");
+    b.add_environment(sky);
+    let encoded = (0.5 * mapped + Vec3::splat(0.5)) * 65535.0;
+    let texture = b.add_texture(Texture {
+        name: "tilt".into(),
+        width: 1,
+        height: 1,
+        texels: vec![[
+            encoded.x.round() as u16,
+            encoded.y.round() as u16,
+            encoded.z.round() as u16,
+            65535,
+        ]],
+    });
+    let mut scene = b.build();
+    scene.materials[floor].textures.clearcoat_normal = Some(TextureRef::new(texture));
+    scene.materials[floor].textures.clearcoat_normal_scale = 1.0;
+    let m = &mut scene.meshes[mesh];
+    m.uvs = vec![
+        m.positions
+            .iter()
+            .map(|p| glam::Vec2::new(p.x, p.z))
+            .collect(),
+    ];
+    m.tangents = vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
+    // T = +X, B = −Z, N = +Y: the coat normal leans towards +X.
+    let n = (mapped.x * Vec3::X + mapped.z * Vec3::Y).normalize();
+    // Seen at 71° from the floor's normal, 41° from the coat's.
+    let direction = v(-2.0, -0.7, 0.0);
+    let wo = -direction.normalize();
+    let expected = sky.as_dvec3() * fresnel(wo.dot(n) as f64, 1.5);
+    let untilted = sky.as_dvec3() * fresnel(wo.dot(Vec3::Y) as f64, 1.5);
+    let target = v(0.2, 0.0, 0.1);
+    let (mean, _) = estimate(
+        &scene,
+        Ray::new(target - direction, direction),
+        Strategy::Mis,
+        16,
+    );
+    assert!(
+        (mean / expected - 1.0).abs().max_element() < 1e-3,
+        "{mean} vs {expected} (an untilted coat would show {untilted})"
+    );
+    assert!((untilted / expected).x > 2.0, "the tilt must matter here");
+}

@@ -139,12 +139,16 @@ impl Renderer<'_> {
             } else {
                 -s.geometric_normal
             };
-            let ns = if shading.normal.dot(ng) < 0.0 {
-                -shading.normal
+            let side = if shading.normal.dot(ng) < 0.0 {
+                -1.0
             } else {
-                shading.normal
+                1.0
             };
-            let bsdf = shading.bsdf;
+            let ns = side * shading.normal;
+            let bsdf = match shading.coat_normal {
+                Some(coat) => shading.bsdf.with_coat_normal(ns, side * coat),
+                None => shading.bsdf,
+            };
 
             // Sample a light for the next-event estimate. Punctual lights can only be found
             // this way, so even the BSDF-only estimator samples them.

@@ -107,7 +107,7 @@ pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
 
 /// An orthonormal basis whose third axis is `n` (Duff et al. 2017, "Building an
 /// orthonormal basis, revisited").
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
     /// First tangent.
     pub s: Vec3,

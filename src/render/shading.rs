@@ -20,6 +20,9 @@ pub struct Shading {
     /// Unit shading normal, normal-mapped where the material says so (not yet turned to
     /// any side).
     pub normal: Vec3,
+    /// The clear coat's own normal where its normal map gives one (on the same side as
+    /// `normal`).
+    pub coat_normal: Option<Vec3>,
 }
 
 /// Texture coordinates of set `set` at vertex `vertex`; zero if the mesh has none.
@@ -60,6 +63,7 @@ impl Renderer<'_> {
                 bsdf: self.bsdfs[s.material][usize::from(!front)],
                 emission: material.emission,
                 normal: s.shading_normal,
+                coat_normal: None,
             };
         }
         let mesh = self.mesh_of(s);
@@ -88,17 +92,19 @@ impl Renderer<'_> {
         if let Some(r) = &textures.emissive {
             emission *= lookup(r, ColorSpace::Srgb).truncate();
         }
-        let normal = match &textures.normal {
+        let mapped = |texture: &Option<TextureRef>, scale: f32| match texture {
             Some(r) if !mesh.tangents.is_empty() => {
                 let texel = lookup(r, ColorSpace::Linear);
-                self.normal_mapped(s, mesh, texel, textures.normal_scale)
+                Some(self.normal_mapped(s, mesh, texel, scale))
             }
-            _ => s.shading_normal,
+            _ => None,
         };
+        let normal = mapped(&textures.normal, textures.normal_scale).unwrap_or(s.shading_normal);
         Shading {
             bsdf: Bsdf::new(&pbr, front),
             emission,
             normal,
+            coat_normal: mapped(&textures.clearcoat_normal, textures.clearcoat_normal_scale),
         }
     }
 

@@ -154,6 +154,10 @@ pub struct MaterialTextures {
     pub normal: Option<TextureRef>,
     /// Scales the normal map's X and Y.
     pub normal_scale: f32,
+    /// The clear coat's own tangent-space normal map (`clearcoatNormalTexture`).
+    pub clearcoat_normal: Option<TextureRef>,
+    /// Scales the coat normal map's X and Y.
+    pub clearcoat_normal_scale: f32,
 }
 
 impl MaterialTextures {
@@ -167,6 +171,7 @@ impl MaterialTextures {
             || self.clearcoat.is_some()
             || self.clearcoat_roughness.is_some()
             || self.normal.is_some()
+            || self.clearcoat_normal.is_some()
     }
 }
 

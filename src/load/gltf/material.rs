@@ -105,7 +105,10 @@ impl GltfLoader {
                     texture,
                     channel: 1,
                 });
-            self.warn_unread_textures(&name, coat, &["clearcoatNormalTexture"]);
+            textures.clearcoat_normal =
+                self.json_texture(document, &coat["clearcoatNormalTexture"], &name);
+            textures.clearcoat_normal_scale =
+                json_f32(&coat["clearcoatNormalTexture"]["scale"], 1.0);
         }
         if let Some(sheen) = material.extension_value("KHR_materials_sheen") {
             pbr.sheen_colour = json_vec3(&sheen["sheenColorFactor"], Vec3::ZERO);

@@ -97,9 +97,12 @@ pub fn load_bytes_with(
     loader.warn_about_unreadable_images(&document);
     for material in document.materials() {
         let m = loader.convert_material(&document, &material);
-        loader
-            .normal_mapped
-            .push(m.textures.normal.map(|n| n.texcoord));
+        loader.normal_mapped.push(
+            m.textures
+                .normal
+                .or(m.textures.clearcoat_normal)
+                .map(|n| n.texcoord),
+        );
         loader.builder.add_material(m);
     }
     loader.load_scene(&document)?;

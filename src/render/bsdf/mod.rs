@@ -64,6 +64,9 @@ pub struct Bsdf {
     glass: Option<(GlassLobe, f32)>,
     /// The clear coat over everything.
     coat: Option<SpecularLobe>,
+    /// The coat's own frame, in the local frame of the shading normal, when a coat normal
+    /// map tilts it (`KHR_materials_clearcoat`'s `clearcoatNormalTexture`).
+    coat_frame: Option<Frame>,
     /// Sheen colour and α, between the coat and the rest.
     sheen: Option<(Vec3, f32)>,
 }
@@ -154,8 +157,29 @@ impl Bsdf {
             metal,
             glass,
             coat,
+            coat_frame: None,
             sheen,
         }
+    }
+
+    /// The same BSDF with the clear coat around its own unit normal `coat_normal` (world
+    /// space, on the side of `n`), for evaluation around the shading normal `n`.
+    pub fn with_coat_normal(mut self, n: Vec3, coat_normal: Vec3) -> Bsdf {
+        if self.coat.is_some() {
+            let local = Frame::from_normal(n).to_local(coat_normal);
+            self.coat_frame = local.try_normalize().map(Frame::from_normal);
+        }
+        self
+    }
+
+    /// A direction of the shading frame in the coat's frame.
+    fn to_coat(&self, w: Vec3) -> Vec3 {
+        self.coat_frame.map_or(w, |f| f.to_local(w))
+    }
+
+    /// A direction of the coat's frame in the shading frame.
+    fn from_coat(&self, w: Vec3) -> Vec3 {
+        self.coat_frame.map_or(w, |f| f.to_world(w))
     }
 
     /// A pure Lambertian BSDF.
@@ -224,14 +248,15 @@ impl Bsdf {
             .any(|l| !l.is_delta())
     }
 
-    /// The factor the coat and sheen leave to what lies beneath them.
-    fn beneath_top(&self, mu_o: f32) -> Vec3 {
+    /// The factor the coat and sheen leave to what lies beneath them, for `wo` in the
+    /// shading frame.
+    fn beneath_top(&self, wo: Vec3) -> Vec3 {
         let mut factor = Vec3::ONE;
         if let Some(coat) = &self.coat {
-            factor *= coat.transmitted(mu_o);
+            factor *= coat.transmitted(self.to_coat(wo).z.max(0.0));
         }
         if let Some((colour, roughness)) = self.sheen {
-            factor *= sheen_transmitted(colour, roughness, mu_o);
+            factor *= sheen_transmitted(colour, roughness, wo.z);
         }
         factor
     }
@@ -241,8 +266,7 @@ impl Bsdf {
         if wo.z <= 0.0 {
             return Vec3::ZERO;
         }
-        let mu_o = wo.z;
-        let beneath = self.beneath_top(mu_o);
+        let beneath = self.beneath_top(wo);
         let mut f = Vec3::ZERO;
         if let Some((glass, w)) = &self.glass {
             f += beneath * glass.eval(wo, wi) * *w;
@@ -250,11 +274,14 @@ impl Bsdf {
         if wi.z <= 0.0 {
             return f;
         }
+        let coat_wo = self.to_coat(wo);
         if let Some(coat) = &self.coat {
-            f += coat.eval(wo, wi);
+            f += coat.eval(coat_wo, self.to_coat(wi));
         }
         if let Some((colour, roughness)) = self.sheen {
-            let factor = self.coat.map_or(Vec3::ONE, |c| c.transmitted(mu_o));
+            let factor = self
+                .coat
+                .map_or(Vec3::ONE, |c| c.transmitted(coat_wo.z.max(0.0)));
             f += factor * colour * charlie_brdf(roughness * roughness, wo, wi);
         }
         if let Some((metal, w)) = &self.metal {
@@ -262,20 +289,26 @@ impl Bsdf {
         }
         let mut base = self.diffuse * FRAC_1_PI;
         if let Some((specular, w)) = &self.specular {
-            base *= specular.transmitted(mu_o);
+            base *= specular.transmitted(wo.z);
             f += beneath * specular.eval(wo, wi) * *w;
         }
         f + beneath * base
     }
 
     /// How often each strategy is chosen, in proportion to the albedo it covers at `wo`.
-    fn strategy_weights(&self, mu_o: f32) -> [f32; 5] {
+    fn strategy_weights(&self, wo: Vec3) -> [f32; 5] {
         let mean = |v: Vec3| v.element_sum() / 3.0;
+        let mu_o = wo.z;
         let mut top = 1.0;
         let mut coat = 0.0;
         let mut cosine = 0.0;
         if let Some(c) = &self.coat {
-            coat = mean(c.albedo(mu_o));
+            let coat_mu = self.to_coat(wo).z;
+            coat = if coat_mu > 0.0 {
+                mean(c.albedo(coat_mu))
+            } else {
+                0.0
+            };
             top = 1.0 - coat;
         }
         if let Some((colour, roughness)) = self.sheen {
@@ -312,7 +345,9 @@ impl Bsdf {
             }
             let p = match strategy {
                 Strategy::Cosine => wi.z.max(0.0) * FRAC_1_PI,
-                Strategy::Coat => self.coat.map_or(0.0, |c| c.pdf_visible(wo, wi)),
+                Strategy::Coat => self
+                    .coat
+                    .map_or(0.0, |c| c.pdf_visible(self.to_coat(wo), self.to_coat(wi))),
                 Strategy::Metal => self.metal.map_or(0.0, |(m, _)| m.pdf_visible(wo, wi)),
                 Strategy::Specular => self.specular.map_or(0.0, |(s, _)| s.pdf_visible(wo, wi)),
                 Strategy::Glass => self.glass.map_or(0.0, |(g, _)| g.pdf(wo, wi)),
@@ -348,7 +383,7 @@ impl Bsdf {
         }
         let frame = Frame::from_normal(n);
         let wo = frame.to_local(wo);
-        let weights = self.strategy_weights(wo.z);
+        let weights = self.strategy_weights(wo);
         self.pdf_local(wo, frame.to_local(wi), &weights)
     }
 
@@ -372,7 +407,7 @@ impl Bsdf {
                 eta_scale: 1.0,
             });
         }
-        let weights = self.strategy_weights(wo.z);
+        let weights = self.strategy_weights(wo);
         let total: f32 = weights.iter().sum();
         if total <= 0.0 {
             return None;
@@ -406,7 +441,10 @@ impl Bsdf {
         }
         let wi = match chosen {
             Strategy::Cosine => Some(cosine_hemisphere(u)),
-            Strategy::Coat => self.coat.and_then(|c| c.sample_visible(wo, u)),
+            Strategy::Coat => self
+                .coat
+                .and_then(|c| c.sample_visible(self.to_coat(wo), u))
+                .map(|wi| self.from_coat(wi)),
             Strategy::Metal => self.metal.and_then(|(m, _)| m.sample_visible(wo, u)),
             Strategy::Specular => self.specular.and_then(|(s, _)| s.sample_visible(wo, u)),
             Strategy::Glass => self.glass.and_then(|(g, _)| g.sample_rough(wo, u, u_rest)),
@@ -444,20 +482,22 @@ impl Bsdf {
         match strategy {
             Strategy::Coat => {
                 let c = self.coat.filter(|c| c.is_delta())?;
-                Some((mirror, c.albedo(mu), 1.0, false))
+                let wo = self.to_coat(wo);
+                let wi = self.from_coat(Vec3::new(-wo.x, -wo.y, wo.z));
+                (wi.z > 0.0).then_some((wi, c.albedo(wo.z), 1.0, false))
             }
             Strategy::Metal => {
                 let (m, w) = self.metal.filter(|(m, _)| m.is_delta())?;
-                Some((mirror, self.beneath_top(mu) * m.albedo(mu) * w, 1.0, false))
+                Some((mirror, self.beneath_top(wo) * m.albedo(mu) * w, 1.0, false))
             }
             Strategy::Specular => {
                 let (s, w) = self.specular.filter(|(s, _)| s.is_delta())?;
-                Some((mirror, self.beneath_top(mu) * s.albedo(mu) * w, 1.0, false))
+                Some((mirror, self.beneath_top(wo) * s.albedo(mu) * w, 1.0, false))
             }
             Strategy::Glass => {
                 let (g, w) = self.glass.filter(|(g, _)| g.is_delta())?;
                 let s = g.sample_delta(wo, u_choice)?;
-                let beneath = self.beneath_top(mu);
+                let beneath = self.beneath_top(wo);
                 Some((
                     s.wi,
                     beneath * s.value * w,
