@@ -173,12 +173,12 @@ impl Bsdf {
     }
 
     /// A direction of the shading frame in the coat's frame.
-    fn into_coat_frame(&self, w: Vec3) -> Vec3 {
+    fn in_coat_frame(&self, w: Vec3) -> Vec3 {
         self.coat_frame.map_or(w, |f| f.to_local(w))
     }
 
     /// A direction of the coat's frame in the shading frame.
-    fn out_of_coat_frame(&self, w: Vec3) -> Vec3 {
+    fn in_shading_frame(&self, w: Vec3) -> Vec3 {
         self.coat_frame.map_or(w, |f| f.to_world(w))
     }
 
@@ -253,7 +253,7 @@ impl Bsdf {
     fn beneath_top(&self, wo: Vec3) -> Vec3 {
         let mut factor = Vec3::ONE;
         if let Some(coat) = &self.coat {
-            factor *= coat.transmitted(self.into_coat_frame(wo).z.max(0.0));
+            factor *= coat.transmitted(self.in_coat_frame(wo).z.max(0.0));
         }
         if let Some((colour, roughness)) = self.sheen {
             factor *= sheen_transmitted(colour, roughness, wo.z);
@@ -274,9 +274,9 @@ impl Bsdf {
         if wi.z <= 0.0 {
             return f;
         }
-        let coat_wo = self.into_coat_frame(wo);
+        let coat_wo = self.in_coat_frame(wo);
         if let Some(coat) = &self.coat {
-            f += coat.eval(coat_wo, self.into_coat_frame(wi));
+            f += coat.eval(coat_wo, self.in_coat_frame(wi));
         }
         if let Some((colour, roughness)) = self.sheen {
             let factor = self
@@ -303,7 +303,7 @@ impl Bsdf {
         let mut coat = 0.0;
         let mut cosine = 0.0;
         if let Some(c) = &self.coat {
-            let coat_mu = self.into_coat_frame(wo).z;
+            let coat_mu = self.in_coat_frame(wo).z;
             coat = if coat_mu > 0.0 {
                 mean(c.albedo(coat_mu))
             } else {
@@ -346,7 +346,7 @@ impl Bsdf {
             let p = match strategy {
                 Strategy::Cosine => wi.z.max(0.0) * FRAC_1_PI,
                 Strategy::Coat => self.coat.map_or(0.0, |c| {
-                    c.pdf_visible(self.into_coat_frame(wo), self.into_coat_frame(wi))
+                    c.pdf_visible(self.in_coat_frame(wo), self.in_coat_frame(wi))
                 }),
                 Strategy::Metal => self.metal.map_or(0.0, |(m, _)| m.pdf_visible(wo, wi)),
                 Strategy::Specular => self.specular.map_or(0.0, |(s, _)| s.pdf_visible(wo, wi)),
@@ -443,8 +443,8 @@ impl Bsdf {
             Strategy::Cosine => Some(cosine_hemisphere(u)),
             Strategy::Coat => self
                 .coat
-                .and_then(|c| c.sample_visible(self.into_coat_frame(wo), u))
-                .map(|wi| self.out_of_coat_frame(wi)),
+                .and_then(|c| c.sample_visible(self.in_coat_frame(wo), u))
+                .map(|wi| self.in_shading_frame(wi)),
             Strategy::Metal => self.metal.and_then(|(m, _)| m.sample_visible(wo, u)),
             Strategy::Specular => self.specular.and_then(|(s, _)| s.sample_visible(wo, u)),
             Strategy::Glass => self.glass.and_then(|(g, _)| g.sample_rough(wo, u, u_rest)),
@@ -482,8 +482,8 @@ impl Bsdf {
         match strategy {
             Strategy::Coat => {
                 let c = self.coat.filter(|c| c.is_delta())?;
-                let wo = self.into_coat_frame(wo);
-                let wi = self.out_of_coat_frame(Vec3::new(-wo.x, -wo.y, wo.z));
+                let wo = self.in_coat_frame(wo);
+                let wi = self.in_shading_frame(Vec3::new(-wo.x, -wo.y, wo.z));
                 (wi.z > 0.0).then_some((wi, c.albedo(wo.z), 1.0, false))
             }
             Strategy::Metal => {
