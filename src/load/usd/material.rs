@@ -156,6 +156,7 @@ impl UsdLoader {
         };
         if self.get_f32(&shader, "inputs:useSpecularWorkflow") == Some(1.0) {
             // The specular workflow gives F0 directly and has no metals.
+            self.warn_if_connected(&shader, "inputs:specularColor", &name);
             let specular = self.constant_colour(&shader, "inputs:specularColor", Vec3::ZERO);
             pbr.metallic = 0.0;
             textures.metallic = None;
@@ -354,7 +355,7 @@ impl UsdLoader {
     pub(super) fn warn_if_connected(&mut self, shader: &sdf::Path, input: &str, material: &str) {
         if self.connected_prim(shader, input).is_some() {
             self.warn(format!(
-                "{material}: {input} is connected to a shader network (textures are not read from USD yet); using its constant value"
+                "{material}: {input} is connected to a shader network, which is not read for this input; using its constant value"
             ));
         }
     }
