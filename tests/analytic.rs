@@ -554,6 +554,48 @@ fn vertex_colours_multiply_the_albedo() {
     assert_matches("coloured floor", estimate, expected, 0.02);
 }
 
+/// Builds `b` with a 10 × 10 floor of `material` facing +Y, with UVs along (x, z) (u along
+/// +X, v along +Z: down the image, so the image's up is −Z) and tangents along +X, and a
+/// 1 × 1 texture encoding the tangent-space normal `mapped` as glTF does; returns the scene
+/// and the texture for a normal-map slot.
+fn normal_mapped_floor(mut b: SceneBuilder, material: usize, mapped: Vec3) -> (Scene, usize) {
+    let v = Vec3::new;
+    let mesh = b.add_mesh(
+        "floor",
+        vec![
+            v(-5., 0., -5.),
+            v(-5., 0., 5.),
+            v(5., 0., 5.),
+            v(5., 0., -5.),
+        ],
+        vec![[0, 1, 2], [0, 2, 3]],
+        material,
+    );
+    b.add_instance(mesh, Affine3A::IDENTITY, "floor");
+    let encoded = (0.5 * mapped + Vec3::splat(0.5)) * 65535.0;
+    let texture = b.add_texture(Texture {
+        name: "tilt".into(),
+        width: 1,
+        height: 1,
+        texels: vec![[
+            encoded.x.round() as u16,
+            encoded.y.round() as u16,
+            encoded.z.round() as u16,
+            65535,
+        ]],
+    });
+    let mut scene = b.build();
+    let m = &mut scene.meshes[mesh];
+    m.uvs = vec![
+        m.positions
+            .iter()
+            .map(|p| glam::Vec2::new(p.x, p.z))
+            .collect(),
+    ];
+    m.tangents = vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
+    (scene, texture)
+}
+
 /// A constant normal map tilts the shading normal by a known angle: under a directional
 /// light the floor's radiance is ρ/π · E · (n′·l) for the tilted n′. Tilting along the red
 /// channel turns the normal towards the tangent (+u); along green, towards the image's up
@@ -578,18 +620,6 @@ fn a_constant_normal_map_tilts_the_shading_normal() {
         let mut b = SceneBuilder::new();
         let floor = b.add_material(Material::diffuse("floor", Vec3::splat(albedo)));
         let v = Vec3::new;
-        let mesh = b.add_mesh(
-            "floor",
-            vec![
-                v(-5., 0., -5.),
-                v(-5., 0., 5.),
-                v(5., 0., 5.),
-                v(5., 0., -5.),
-            ],
-            vec![[0, 1, 2], [0, 2, 3]],
-            floor,
-        );
-        b.add_instance(mesh, Affine3A::IDENTITY, "floor");
         b.add_light(Light {
             name: "sun".into(),
             kind: LightKind::Directional {
@@ -598,30 +628,9 @@ fn a_constant_normal_map_tilts_the_shading_normal() {
             },
             source: "test".into(),
         });
-        let encoded = (0.5 * mapped + Vec3::splat(0.5)) * 65535.0;
-        let texture = b.add_texture(Texture {
-            name: "tilt".into(),
-            width: 1,
-            height: 1,
-            texels: vec![[
-                encoded.x.round() as u16,
-                encoded.y.round() as u16,
-                encoded.z.round() as u16,
-                65535,
-            ]],
-        });
-        let mut scene = b.build();
+        let (mut scene, texture) = normal_mapped_floor(b, floor, mapped);
         scene.materials[floor].textures.normal = Some(TextureRef::new(texture));
         scene.materials[floor].textures.normal_scale = 1.0;
-        // u along +X, v along +Z (down the image), so the image's up is −Z; the floor faces +Y.
-        let m = &mut scene.meshes[mesh];
-        m.uvs = vec![
-            m.positions
-                .iter()
-                .map(|p| glam::Vec2::new(p.x, p.z))
-                .collect(),
-        ];
-        m.tangents = vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
         // The world normal: T = +X, B = w·N×T = −Z, N = +Y.
         let n = (mapped.x * Vec3::X + mapped.y * Vec3::NEG_Z + mapped.z * Vec3::Y).normalize();
         let l = -travel.normalize();
@@ -683,42 +692,10 @@ fn a_coat_normal_map_tilts_the_coat() {
         },
     ));
     let v = Vec3::new;
-    let mesh = b.add_mesh(
-        "floor",
-        vec![
-            v(-5., 0., -5.),
-            v(-5., 0., 5.),
-            v(5., 0., 5.),
-            v(5., 0., -5.),
-        ],
-        vec![[0, 1, 2], [0, 2, 3]],
-        floor,
-    );
-    b.add_instance(mesh, Affine3A::IDENTITY, "floor");
     b.add_environment(sky);
-    let encoded = (0.5 * mapped + Vec3::splat(0.5)) * 65535.0;
-    let texture = b.add_texture(Texture {
-        name: "tilt".into(),
-        width: 1,
-        height: 1,
-        texels: vec![[
-            encoded.x.round() as u16,
-            encoded.y.round() as u16,
-            encoded.z.round() as u16,
-            65535,
-        ]],
-    });
-    let mut scene = b.build();
+    let (mut scene, texture) = normal_mapped_floor(b, floor, mapped);
     scene.materials[floor].textures.clearcoat_normal = Some(TextureRef::new(texture));
     scene.materials[floor].textures.clearcoat_normal_scale = 1.0;
-    let m = &mut scene.meshes[mesh];
-    m.uvs = vec![
-        m.positions
-            .iter()
-            .map(|p| glam::Vec2::new(p.x, p.z))
-            .collect(),
-    ];
-    m.tangents = vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
     // T = +X, B = −Z, N = +Y: the coat normal leans towards +X.
     let n = (mapped.x * Vec3::X + mapped.z * Vec3::Y).normalize();
     // Seen at 71° from the floor's normal, 41° from the coat's.
