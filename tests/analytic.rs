@@ -517,18 +517,7 @@ fn vertex_colours_multiply_the_albedo() {
         ..Material::diffuse("light", Vec3::ZERO).with_emission(radiance)
     });
     let v = Vec3::new;
-    let mesh = b.add_mesh(
-        "floor",
-        vec![
-            v(-20., 0., -20.),
-            v(-20., 0., 20.),
-            v(20., 0., 20.),
-            v(20., 0., -20.),
-        ],
-        vec![[0, 1, 2], [0, 2, 3]],
-        floor,
-    );
-    b.add_instance(mesh, Affine3A::IDENTITY, "floor");
+    let mesh = add_floor(&mut b, 20.0, floor);
     add_quad(
         &mut b,
         [
@@ -554,24 +543,31 @@ fn vertex_colours_multiply_the_albedo() {
     assert_matches("coloured floor", estimate, expected, 0.02);
 }
 
-/// Builds `b` with a 10 × 10 floor of `material` facing +Y, with UVs along (x, z) (u along
-/// +X, v along +Z: down the image, so the image's up is −Z) and tangents along +X, and a
-/// 1 × 1 texture encoding the tangent-space normal `mapped` as glTF does; returns the scene
-/// and the texture for a normal-map slot.
-fn normal_mapped_floor(mut b: SceneBuilder, material: usize, mapped: Vec3) -> (Scene, usize) {
-    let v = Vec3::new;
+/// A square floor of half-side `half` in the plane y = 0, facing +Y, as one mesh with its
+/// own instance (so that per-vertex attributes can be set on it); returns the mesh.
+fn add_floor(b: &mut SceneBuilder, half: f32, material: usize) -> usize {
+    let v = |x: f32, z: f32| Vec3::new(x, 0.0, z);
     let mesh = b.add_mesh(
         "floor",
         vec![
-            v(-5., 0., -5.),
-            v(-5., 0., 5.),
-            v(5., 0., 5.),
-            v(5., 0., -5.),
+            v(-half, -half),
+            v(-half, half),
+            v(half, half),
+            v(half, -half),
         ],
         vec![[0, 1, 2], [0, 2, 3]],
         material,
     );
     b.add_instance(mesh, Affine3A::IDENTITY, "floor");
+    mesh
+}
+
+/// Builds `b` with a 10 × 10 floor of `material` facing +Y, with UVs along (x, z) (u along
+/// +X, v along +Z: down the image, so the image's up is −Z) and tangents along +X, and a
+/// 1 × 1 texture encoding the tangent-space normal `mapped` as glTF does; returns the scene
+/// and the texture for a normal-map slot.
+fn normal_mapped_floor(mut b: SceneBuilder, material: usize, mapped: Vec3) -> (Scene, usize) {
+    let mesh = add_floor(&mut b, 5.0, material);
     let encoded = (0.5 * mapped + Vec3::splat(0.5)) * 65535.0;
     let texture = b.add_texture(Texture {
         name: "tilt".into(),

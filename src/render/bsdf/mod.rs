@@ -182,11 +182,6 @@ impl Bsdf {
         self.coat_frame.map_or(w, |f| f.to_world(w))
     }
 
-    /// A pure Lambertian BSDF.
-    pub fn lambertian(albedo: Vec3) -> Bsdf {
-        Bsdf::new(&Pbr::diffuse(albedo), true)
-    }
-
     /// Names of the lobes, for `--inspect` and messages.
     pub fn lobe_names(&self) -> Vec<&'static str> {
         let mut names = Vec::new();
@@ -235,17 +230,9 @@ impl Bsdf {
             && self.sheen.is_none()
     }
 
+    /// True when the cosine strategy (Lambertian base, sheen) has anything to draw.
     fn has_cosine_lobes(&self) -> bool {
-        self.diffuse.max_element() > 0.0
-            || self.sheen.is_some()
-            || [
-                self.coat,
-                self.metal.map(|m| m.0),
-                self.specular.map(|s| s.0),
-            ]
-            .iter()
-            .flatten()
-            .any(|l| !l.is_delta())
+        self.diffuse.max_element() > 0.0 || self.sheen.is_some()
     }
 
     /// The factor the coat and sheen leave to what lies beneath them, for `wo` in the
