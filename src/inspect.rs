@@ -1,7 +1,6 @@
 //! `gridtrace --inspect`: a plain-text account of what a loader made of a file, so a user can
 //! see how each material was mapped, how strong each light is and what was skipped.
 
-use std::f32::consts::PI;
 use std::fmt::Write;
 
 use glam::Vec3;
@@ -53,6 +52,26 @@ pub fn describe(scene: &Scene, warnings: &[String]) -> String {
             light.source,
             light_summary(&light.kind)
         );
+    }
+    match &scene.environment {
+        None => {
+            let _ = writeln!(out, "environment: none");
+        }
+        Some(e) => {
+            let what = match &e.map {
+                None => format!("constant radiance {}", vector(e.tint)),
+                Some(m) => format!(
+                    "map {} ({}x{}) × {}, mean radiance {}",
+                    m.name,
+                    m.width,
+                    m.height,
+                    vector(e.tint),
+                    vector(e.mean_radiance())
+                ),
+            };
+            let hidden = if e.camera_visible { "" } else { ", hidden from the camera" };
+            let _ = writeln!(out, "environment ({}): {what}{hidden}", e.source);
+        }
     }
     let _ = writeln!(out, "cameras: {}", scene.cameras.len());
     for (i, c) in scene.cameras.iter().enumerate() {
@@ -191,8 +210,7 @@ fn emitted_power(scene: &Scene) -> Vec<f32> {
             })
             .filter(|a| a.is_finite())
             .sum();
-        let sides = if material.double_sided { 2.0 } else { 1.0 };
-        power[mesh.material] += sides * PI * area * material.emission.element_sum() / 3.0;
+        power[mesh.material] += area * material.exitance();
     }
     power
 }
@@ -207,7 +225,7 @@ fn light_summary(kind: &LightKind) -> String {
             "point at {}, intensity {} W/sr, {} W{}",
             vector(position),
             vector(intensity),
-            significant(4.0 * PI * intensity.element_sum() / 3.0),
+            significant(kind.power(0.0)),
             range.map_or(String::new(), |r| format!(", range {r}"))
         ),
         LightKind::Spot {

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
+use super::environment::{EnvironmentChoice, parse_degrees, parse_environment, parse_strength};
 use crate::limits::parse_size;
 use crate::load::GltfLightUnits;
 use crate::record::parse_range;
@@ -119,6 +120,27 @@ pub struct Args {
     /// file on which a third-party reader loops must not hang a farm job.
     #[arg(long, value_name = "SECONDS", default_value_t = 600.0, value_parser = parse_seconds)]
     pub load_timeout: f64,
+
+    /// Light from far away: a latitude–longitude (equirectangular) .hdr or .exr image,
+    /// oriented as Blender's world shows it; a constant radiance, one number or R,G,B; or
+    /// "none". Replaces the scene's own (a USD dome light). [default: the scene's; a neutral
+    /// studio light when the scene has no light at all]
+    #[arg(long, value_name = "FILE|R,G,B|none", value_parser = parse_environment)]
+    pub environment: Option<EnvironmentChoice>,
+
+    /// Multiplies the environment's radiance, whichever it is.
+    #[arg(long, value_name = "FACTOR", default_value_t = 1.0, value_parser = parse_strength)]
+    pub environment_strength: f32,
+
+    /// Turns the environment about the up axis, in degrees (counter-clockwise seen from
+    /// above).
+    #[arg(long, value_name = "DEGREES", default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_degrees)]
+    pub environment_rotation: f32,
+
+    /// The environment lights the scene, but camera rays that miss everything see black with
+    /// alpha 0 (a product shot over a transparent background).
+    #[arg(long)]
+    pub hide_environment: bool,
 
     /// Every SECONDS, write the image so far to the output (atomically, as a part that
     /// `gridtrace merge` accepts), so a killed render keeps its samples.

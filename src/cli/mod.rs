@@ -3,6 +3,7 @@
 //! and exits with 128 + the signal's number ([`signals`]).
 
 mod args;
+mod environment;
 pub mod signals;
 
 pub use args::{Args, Command, MergeArgs};
@@ -25,6 +26,7 @@ use crate::output::{Format, check_writable, write_image_with_record};
 use crate::record::{RenderIdentity, RenderRecord, format_range, sha256_file, sha256_files};
 use crate::render::{Image, RenderSettings, RenderStats, Renderer, Strategy, film_bytes};
 use crate::scene::{Camera, Scene};
+use environment::apply_environment;
 use signals::{Phase, output_lock, set_phase};
 
 /// Image height used when neither --width nor --height is given.
@@ -78,7 +80,8 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     }
     signals::arm_load_timeout(Duration::from_secs_f64(args.load_timeout), scene_path);
     if args.inspect {
-        let loaded = load_scene_with(scene_path, &options)?;
+        let mut loaded = load_scene_with(scene_path, &options)?;
+        apply_environment(&mut loaded.scene, args, scene_path)?;
         set_phase(Phase::Finished);
         print!(
             "{}:\n{}",
@@ -118,7 +121,9 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
-    let scene = loaded.scene;
+    let mut scene = loaded.scene;
+    let (environment_note, environment_label) =
+        apply_environment(&mut scene, args, scene_path)?;
     let triangles = scene.instanced_triangle_count() as u64;
     if triangles > args.max_triangles {
         bail!(
@@ -132,9 +137,11 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
             "warning: {}: the scene has no triangles; the image will be empty",
             scene_path.display()
         );
+    } else if let Some(note) = environment_note {
+        eprintln!("{note}");
     } else if !scene.has_emitters() {
         eprintln!(
-            "warning: {}: the scene has no emitters (no emissive material, no light); the image will be black",
+            "warning: {}: the scene has no emitters (no emissive material, no light, no environment); the image will be black",
             scene_path.display()
         );
     }
@@ -203,7 +210,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         height,
         seed: settings.seed,
         max_depth: settings.max_depth,
-        load_options: load_options_label(&options),
+        load_options: format!("{} {environment_label}", load_options_label(&options)),
     };
     let scene_name = scene_path
         .file_name()

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 use crate::accel::Triangle;
 use crate::record::Dependency;
-use crate::scene::Scene;
+use crate::scene::{EnvironmentMap, Scene};
 
 /// A loaded scene and the warnings met on the way (things skipped or approximated).
 #[derive(Debug)]
@@ -157,4 +157,20 @@ fn load_by_format(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadErro
             path: path.to_path_buf(),
         })
     }
+}
+
+/// Reads a latitude–longitude environment map (`.hdr`, `.exr`, or an 8-bit image taken as
+/// sRGB) named on the command line, within the memory budget.
+pub fn load_environment_map(path: &Path) -> Result<EnvironmentMap, LoadError> {
+    let name = path.display().to_string();
+    let bytes = access::read_regular_file(path, &name, crate::limits::memory_budget()).map_err(
+        |e| LoadError::Invalid {
+            path: path.to_path_buf(),
+            what: e.to_string(),
+        },
+    )?;
+    images::decode_environment(name, &bytes).map_err(|why| LoadError::Invalid {
+        path: path.to_path_buf(),
+        what: format!("environment map {why}"),
+    })
 }

@@ -77,8 +77,12 @@ impl Renderer<'_> {
         loop {
             result.rays += 1;
             let Some(hit) = self.accel.intersect(&ray) else {
-                // The path leaves the scene: the environment, weighed like any emitter.
-                let (environment, light_pdf) = self.lights.environment();
+                // The path leaves the scene: the environment, weighed like any emitter,
+                // unless it is hidden from camera rays.
+                let (environment, light_pdf) = self.lights.environment(ray.direction);
+                if depth == 0 && !self.environment_visible {
+                    break;
+                }
                 if environment != Vec3::ZERO {
                     let weight = match (arrival, strategy) {
                         (Arrival::Specular, _) | (_, Strategy::BsdfOnly) => 1.0,
@@ -97,8 +101,11 @@ impl Renderer<'_> {
                 beta *= (-sigma * segment).exp();
             }
             let s = surface_at(self.scene, &self.frames, &hit);
-            if !self.is_present(&s, rng) {
-                // A cutout or a blended surface the ray passes: go on in the same direction.
+            let material = &self.scene.materials[s.material];
+            let hidden = depth == 0 && !material.camera_visible;
+            if hidden || !self.is_present(&s, rng) {
+                // A cutout, a blended surface the ray passes or a surface the camera does
+                // not see: go on in the same direction.
                 pass_throughs += 1;
                 if pass_throughs > MAX_PASS_THROUGHS {
                     break;
@@ -114,7 +121,6 @@ impl Renderer<'_> {
             let wo = -ray.direction.normalize();
             let cos_o = s.geometric_normal.dot(wo);
             let front = cos_o > 0.0;
-            let material = &self.scene.materials[s.material];
             let shading = self.shade(&s, front);
 
             // Emission reached by the previous bounce.

@@ -90,6 +90,8 @@ pub struct Renderer<'a> {
     frames: Vec<InstanceFrame>,
     /// True when some material has alpha cutouts or blending, so hits must be checked.
     has_cutouts: bool,
+    /// False when camera rays that leave the scene must see black (alpha 0).
+    environment_visible: bool,
     /// Each material's BSDF for rays arriving on its front and on its back side, made once
     /// (materials that textures vary are made again at each hit).
     bsdfs: Vec<[Bsdf; 2]>,
@@ -104,6 +106,7 @@ impl<'a> Renderer<'a> {
             lights: LightSet::build(scene),
             frames: InstanceFrame::for_scene(scene),
             has_cutouts: scene.materials.iter().any(|m| m.is_cutout()),
+            environment_visible: scene.environment.as_ref().is_none_or(|e| e.camera_visible),
             bsdfs: scene
                 .materials
                 .iter()

@@ -2,7 +2,7 @@
 
 use glam::{Affine3A, Vec3};
 
-use super::{Camera, Instance, Light, Material, Mesh, Scene, Texture};
+use super::{Camera, Environment, Instance, Light, Material, Mesh, Scene, Texture};
 
 /// Builds a [`Scene`] piece by piece.
 ///
@@ -96,9 +96,28 @@ impl SceneBuilder {
         self.scene.textures.len() - 1
     }
 
-    /// Adds constant radiance from every direction that misses the scene.
-    pub fn add_environment(&mut self, radiance: Vec3) {
-        self.scene.environment += radiance;
+    /// Adds constant radiance from every direction that misses the scene, summed with an
+    /// earlier constant environment. Returns false, changing nothing, when the environment
+    /// is already a map (the caller says what it drops).
+    pub fn add_environment(&mut self, radiance: Vec3) -> bool {
+        match &mut self.scene.environment {
+            Some(e) if e.map.is_none() => e.tint += radiance,
+            Some(_) => return false,
+            None => {
+                self.scene.environment = Some(Environment::constant(radiance, "environment"))
+            }
+        }
+        true
+    }
+
+    /// True when an environment has been set or added.
+    pub fn scene_environment_is_set(&self) -> bool {
+        self.scene.environment.is_some()
+    }
+
+    /// Sets the environment, replacing any other.
+    pub fn set_environment(&mut self, environment: Environment) {
+        self.scene.environment = Some(environment);
     }
 
     /// Adds a punctual light.

@@ -89,9 +89,11 @@ impl Camera {
 }
 
 impl Camera {
-    /// A perspective camera that frames `bounds`: it looks down −Z from the +Z side (the
-    /// front view in glTF's Y-up convention) with a 40° vertical field of view, far enough
-    /// back that the bounding sphere fits both vertically and horizontally at `aspect`.
+    /// A perspective camera that frames `bounds` from a three-quarter view, as model
+    /// viewers open a model: from the front (+Z, glTF's forward) turned 35° towards +X and
+    /// 25° above the horizon (Y up), looking at the centre with a 40° vertical field of view,
+    /// far enough back that the bounding sphere fits both vertically and horizontally at
+    /// `aspect`. A flat object lying or standing in any axis plane is seen at an angle.
     pub fn framing(bounds: &crate::scene::Aabb, aspect: f32) -> Camera {
         let yfov = 40f32.to_radians();
         let (center, radius) = if bounds.is_empty() {
@@ -102,9 +104,25 @@ impl Camera {
         let half_y = 0.5 * yfov;
         let half_x = (half_y.tan() * aspect).atan();
         let distance = radius / half_y.min(half_x).sin();
+        let (azimuth, elevation) = (35f32.to_radians(), 25f32.to_radians());
+        let towards_camera = glam::Vec3::new(
+            azimuth.sin() * elevation.cos(),
+            elevation.sin(),
+            azimuth.cos() * elevation.cos(),
+        );
+        let eye = center + distance * towards_camera;
+        // Camera space looks down −Z with +Y up.
+        let back = towards_camera;
+        let right = glam::Vec3::Y.cross(back).normalize();
+        let up = back.cross(right);
         Camera {
             name: "default".into(),
-            world_from_camera: Affine3A::from_translation(center + glam::Vec3::Z * distance),
+            world_from_camera: Affine3A::from_cols(
+                right.into(),
+                up.into(),
+                back.into(),
+                eye.into(),
+            ),
             projection: Projection::Perspective {
                 yfov,
                 aspect_ratio: Some(aspect),

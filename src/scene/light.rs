@@ -1,6 +1,8 @@
 //! Lights without area (glTF `KHR_lights_punctual`): they are reached only by sampling them,
 //! never by a ray, so the integrator handles them apart from emissive surfaces.
 
+use std::f32::consts::PI;
+
 use glam::Vec3;
 
 /// What a punctual light is and where it shines, in world space and radiometric units.
@@ -75,6 +77,31 @@ impl LightKind {
             LightKind::Directional { .. } => Vec3::ZERO,
         }
     }
+}
+
+impl LightKind {
+    /// Emitted power (W), mean over channels: what light selection weighs and `--inspect`
+    /// prints. A spot counts its cone up to halfway through the falloff; a directional
+    /// light, what crosses the disc of the sphere (radius `scene_radius`) around the scene.
+    pub fn power(&self, scene_radius: f32) -> f32 {
+        match *self {
+            LightKind::Point { intensity, .. } => 4.0 * PI * mean(intensity),
+            LightKind::Spot {
+                intensity,
+                cos_inner,
+                cos_outer,
+                ..
+            } => 2.0 * PI * (1.0 - 0.5 * (cos_inner + cos_outer)) * mean(intensity),
+            LightKind::Directional { irradiance, .. } => {
+                PI * scene_radius * scene_radius * mean(irradiance)
+            }
+        }
+    }
+}
+
+/// Mean of the three channels.
+fn mean(v: Vec3) -> f32 {
+    v.element_sum() / 3.0
 }
 
 /// The glTF `KHR_lights_punctual` spot attenuation: linear in the cosine between the outer

@@ -197,6 +197,10 @@ pub struct Material {
     /// Absorption coefficient (per scene unit) inside a glass volume: Beer–Lambert
     /// attenuation exp(−σ·d) along paths through it. Zero: clear.
     pub absorption: Vec3,
+    /// When false, camera rays pass through the surface as if it were not there, while it
+    /// still scatters, emits and casts shadows for every other ray: a lamp's shape, which
+    /// Cycles does not show to the camera.
+    pub camera_visible: bool,
 }
 
 impl Material {
@@ -212,6 +216,7 @@ impl Material {
             alpha: 1.0,
             alpha_mode: AlphaMode::Opaque,
             absorption: Vec3::ZERO,
+            camera_visible: true,
         }
     }
 
@@ -240,6 +245,13 @@ impl Material {
     pub fn with_emission(mut self, radiance: Vec3) -> Material {
         self.emission = radiance;
         self
+    }
+
+    /// Power emitted per unit area (W/m², mean over channels): π × radiance from each
+    /// emitting side. Textured emission scales it by the texture's mean.
+    pub fn exitance(&self) -> f32 {
+        let sides = if self.double_sided { 2.0 } else { 1.0 };
+        sides * std::f32::consts::PI * self.emission.element_sum() / 3.0
     }
 
     /// True when the material emits light.

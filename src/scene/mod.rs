@@ -6,6 +6,7 @@
 
 mod builder;
 mod camera;
+mod environment;
 mod light;
 mod material;
 mod mesh;
@@ -13,6 +14,9 @@ mod texture;
 
 pub use builder::SceneBuilder;
 pub use camera::{Camera, Projection};
+pub use environment::{
+    Environment, EnvironmentMap, blender_world_rotation, map_direction, map_uv,
+};
 pub use light::{Light, LightKind};
 pub use material::{AlphaMode, ChannelRef, Material, MaterialTextures, Pbr, f0_of_ior};
 pub use mesh::Mesh;
@@ -118,9 +122,9 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Decoded images, indexed by [`TextureRef::texture`].
     pub textures: Vec<Texture>,
-    /// Radiance arriving from every direction no geometry covers (a constant dome light);
-    /// zero: black.
-    pub environment: Vec3,
+    /// Radiance arriving from every direction no geometry covers (a dome light, an HDR
+    /// map); `None`: black.
+    pub environment: Option<Environment>,
 }
 
 impl Scene {
@@ -138,7 +142,7 @@ impl Scene {
     /// True when some instanced mesh has an emissive material or there is a punctual light.
     pub fn has_emitters(&self) -> bool {
         !self.lights.is_empty()
-            || self.environment.max_element() > 0.0
+            || self.environment.as_ref().is_some_and(|e| !e.is_black())
             || self.instances.iter().any(|inst| {
                 let mesh = &self.meshes[inst.mesh];
                 self.materials[mesh.material].is_emissive() && !mesh.indices.is_empty()

@@ -151,6 +151,7 @@ impl GltfLoader {
             alpha,
             alpha_mode,
             absorption,
+            camera_visible: true,
         }
     }
 

@@ -236,7 +236,8 @@ struct GltfLoader {
     missing_images: HashSet<usize>,
     /// For each glTF material: the texture-coordinate set its normal map uses, if any.
     normal_mapped: Vec<Option<usize>>,
-    /// glTF materials used by a primitive with vertex colours.
+    /// Scene materials (glTF materials and the default one) used by a primitive with vertex
+    /// colours.
     coloured_materials: HashSet<usize>,
     warnings: Vec<String>,
 }
@@ -525,12 +526,11 @@ impl GltfLoader {
                 "{name}: {leftover} index(es) left over after the last whole triangle"
             ));
         }
+        // COLOR_0 multiplies the base colour of any material, the default one included
+        // (glTF 2.0 §3.7.2.1).
         let material = self.material_for(primitive);
-        let gltf_material = primitive.material().index();
-        if !colours.is_empty()
-            && let Some(m) = gltf_material
-        {
-            self.coloured_materials.insert(m);
+        if !colours.is_empty() {
+            self.coloured_materials.insert(material);
         }
         let mut mesh = Mesh {
             name,

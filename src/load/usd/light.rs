@@ -1,10 +1,10 @@
 //! UsdLux lights and UsdGeom cameras, as scene lights and cameras.
 
-use glam::{Affine3A, Mat4, Vec3};
+use glam::{Affine3A, Mat3, Mat4, Vec3};
 use openusd::sdf;
 
-use super::{DISK_SEGMENTS, UsdLoader, as_bool, as_vec3};
-use crate::scene::{Camera, Light, LightKind, Material, Projection};
+use super::{DISK_SEGMENTS, UsdLoader, as_asset, as_bool, as_vec3};
+use crate::scene::{Camera, Environment, Light, LightKind, Material, Projection};
 
 impl UsdLoader {
     /// A UsdLux light's `intensity × 2^exposure × color`, tinted by its colour temperature
@@ -34,23 +34,67 @@ impl UsdLoader {
         colour * intensity * exposure.exp2()
     }
 
-    /// A `DomeLight` of constant colour: radiance intensity × 2^exposure × color from every
-    /// direction the scene leaves open. A texture (an environment map) is not read.
-    pub(super) fn add_dome(&mut self, prim: &sdf::Path) {
-        let where_ = prim.as_str();
-        let radiance = self.light_strength(prim);
-        if self.get(prim, "inputs:texture:file").is_some() {
-            self.warn(format!(
-                "{where_}: DomeLight texture maps are not supported; using its constant colour"
-            ));
-        }
-        if radiance.is_finite() && radiance.min_element() >= 0.0 {
-            self.builder.add_environment(radiance);
-        } else {
+    /// A `DomeLight`: radiance intensity × 2^exposure × color from every direction the
+    /// scene leaves open, times its latitude–longitude `texture:file` if it has one. The map
+    /// is read in the OpenEXR convention, its pole along the dome's +Y (`DomeLight`) or,
+    /// for `DomeLight_1`, along the stage's up axis unless `poleAxis` says Y, then placed by
+    /// the dome's transform.
+    pub(super) fn add_dome(&mut self, prim: &sdf::Path, type_name: &str, world: Mat4) {
+        let where_ = prim.as_str().to_string();
+        let tint = self.light_strength(prim);
+        if !tint.is_finite() || tint.min_element() < 0.0 {
             self.warn(format!(
                 "{where_}: negative or non-finite dome light; skipped"
             ));
+            return;
         }
+        let file = self.get(prim, "inputs:texture:file").as_ref().and_then(as_asset);
+        let Some(file) = file.filter(|f| !f.is_empty()) else {
+            if !self.builder.add_environment(tint) {
+                self.warn(format!(
+                    "{where_}: a second dome light, of constant colour, is ignored beside an environment map"
+                ));
+            }
+            return;
+        };
+        let format = self
+            .get_token(prim, "inputs:texture:format")
+            .unwrap_or_else(|| "automatic".into());
+        if !matches!(format.as_str(), "automatic" | "latlong") {
+            self.warn(format!(
+                "{where_}: texture:format '{format}' is not supported (only latlong); reading the map as latlong"
+            ));
+        }
+        let Some(map) = self.environment_file(&file, &where_) else {
+            return;
+        };
+        // The pole: DomeLight_1 aligns it with the stage's up axis by default.
+        let pole_axis = self
+            .get_token(prim, "poleAxis")
+            .unwrap_or_else(|| "scene".into());
+        let pole = if type_name == "DomeLight_1" && pole_axis != "Y" && self.stage_up_is_z() {
+            Mat3::from_rotation_x(std::f32::consts::FRAC_PI_2)
+        } else {
+            Mat3::IDENTITY
+        };
+        let (_, rotation, _) = world.to_scale_rotation_translation();
+        let world_from_map = Mat3::from_quat(rotation.normalize()) * pole;
+        if self.builder.scene_environment_is_set() {
+            self.warn(format!(
+                "{where_}: more than one dome light; the last one's map replaces the others"
+            ));
+        }
+        let mut environment = Environment::from_map(map, tint, world_from_map, where_.clone());
+        environment.camera_visible = self.camera_visibility(prim).unwrap_or(true);
+        self.builder.set_environment(environment);
+    }
+
+    /// The lamp's camera visibility where the file says it (Karma's `renderlightgeo`,
+    /// RenderMan's camera visibility primvar); `None` when it does not.
+    fn camera_visibility(&self, prim: &sdf::Path) -> Option<bool> {
+        ["karma:light:renderlightgeo", "primvars:ri:attributes:visibility:camera"]
+            .iter()
+            .find_map(|name| self.get(prim, name).as_ref().and_then(as_bool))
     }
 
     pub(super) fn add_camera(&mut self, prim: &sdf::Path, world: Mat4) {
@@ -96,7 +140,9 @@ impl UsdLoader {
         });
     }
 
-    /// UsdLux lights. Radiance (area lights) or radiant intensity (points) is
+    /// UsdLux lights. Area lights and spheres are emitting surfaces that camera rays do not
+    /// see unless the file asks (see [`UsdLoader::camera_visibility`]). Radiance (area
+    /// lights) or radiant intensity (points) is
     /// `intensity × 2^exposure × color`; `normalize` divides by the light's area, so that
     /// the power (π × radiance × area) stays `π × intensity` whatever its size — which is
     /// how Blender writes watts (intensity = W/π).
@@ -121,6 +167,9 @@ impl UsdLoader {
             .x_axis
             .cross(transform.matrix3.y_axis)
             .length();
+        // Lamps are not seen by camera rays (as in Cycles, Karma and Storm) unless the file
+        // says they are.
+        let camera_visible = self.camera_visibility(prim).unwrap_or(false);
         let emitter =
             |loader: &mut UsdLoader, positions: Vec<Vec3>, indices: Vec<[u32; 3]>, area: f32| {
                 let radiance = if normalize {
@@ -130,6 +179,7 @@ impl UsdLoader {
                 };
                 let material = loader.builder.add_material(Material {
                     double_sided: false,
+                    camera_visible,
                     ..Material::diffuse(where_.clone(), Vec3::ZERO).with_emission(radiance)
                 });
                 let mesh = loader

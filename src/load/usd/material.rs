@@ -8,9 +8,9 @@ use openusd::sdf;
 use super::{UsdLoader, as_vec3};
 use crate::limits::memory_budget;
 use crate::load::access::read_regular_file;
-use crate::load::images::decode_texture;
+use crate::load::images::{decode_environment, decode_texture};
 use crate::scene::{
-    AlphaMode, ChannelRef, ColorSpace, Material, MaterialTextures, Pbr, TextureRef, Wrap, f0_of_ior,
+    AlphaMode, ChannelRef, ColorSpace, EnvironmentMap, Material, MaterialTextures, Pbr, TextureRef, Wrap, f0_of_ior,
 };
 
 impl UsdLoader {
@@ -330,6 +330,30 @@ impl UsdLoader {
         };
         self.textures.insert(file.to_string(), decoded);
         decoded
+    }
+
+    /// The environment map in image file `file` relative to the stage, or `None` with a
+    /// warning naming `prim`.
+    pub(super) fn environment_file(&mut self, file: &str, prim: &str) -> Option<EnvironmentMap> {
+        let base = self.path.parent().unwrap_or(Path::new("."));
+        let map = self
+            .roots
+            .resolve(base, file)
+            .and_then(|full| {
+                self.texture_paths.push(full.clone());
+                read_regular_file(&full, file, memory_budget())
+            })
+            .map_err(|e| e.to_string())
+            .and_then(|bytes| {
+                decode_environment(file.to_string(), &bytes).map_err(|e| format!("'{file}' {e}"))
+            });
+        match map {
+            Ok(map) => Some(map),
+            Err(why) => {
+                self.warn(format!("{prim}: dome texture {why}; the dome light is skipped"));
+                None
+            }
+        }
     }
 
     /// The name of the output (`outputs:r`, …) that feeds `property` of `prim`, if any.

@@ -288,6 +288,14 @@ fn as_token(v: &sdf::Value) -> Option<String> {
     }
 }
 
+fn as_asset(v: &sdf::Value) -> Option<String> {
+    match v {
+        sdf::Value::AssetPath(a) => Some(a.authored_path.clone()),
+        sdf::Value::String(s) => Some(s.clone()),
+        _ => None,
+    }
+}
+
 fn as_bool(v: &sdf::Value) -> Option<bool> {
     match v {
         sdf::Value::Bool(b) => Some(*b),
@@ -335,6 +343,17 @@ impl UsdLoader {
 
     fn get_token(&self, prim: &sdf::Path, name: &str) -> Option<String> {
         self.get(prim, name).as_ref().and_then(as_token)
+    }
+
+    /// True when the stage says its up axis is Z.
+    fn stage_up_is_z(&self) -> bool {
+        self.stage
+            .stage_metadata("upAxis")
+            .ok()
+            .flatten()
+            .as_ref()
+            .and_then(as_token)
+            .is_some_and(|up| up == "Z")
     }
 
     /// The transform from stage space to gridtrace's: Y up, metres.
@@ -430,7 +449,7 @@ impl UsdLoader {
             "RectLight" | "DiskLight" | "SphereLight" | "DistantLight" => {
                 self.add_light(&path, &type_name, world)
             }
-            "DomeLight" => self.add_dome(&path),
+            "DomeLight" | "DomeLight_1" => self.add_dome(&path, &type_name, world),
             "" | "Xform" | "Scope" | "SkelRoot" => {}
             "Sphere" | "Cube" | "Cylinder" | "Cone" | "Capsule" | "Plane" | "Points"
             | "BasisCurves" | "NurbsCurves" | "NurbsPatch" | "PointInstancer" | "Volume" => self

@@ -1,13 +1,17 @@
-//! The lights next-event estimation samples: every triangle of an emissive material, in
-//! world space, and every punctual light, each chosen in proportion to its emitted power.
+//! The lights next-event estimation samples — every triangle of an emissive material in
+//! world space, every punctual light, the environment — each chosen in proportion to its
+//! emitted power ([`Light`] names one of them; each kind has its power and density here or
+//! beside its data, and nowhere else).
 
-use std::f32::consts::PI;
+mod environment;
 
 use std::collections::HashMap;
 
 use glam::{Vec2, Vec3};
 
-use super::sampling::{Distribution1d, uniform_sphere, uniform_triangle};
+pub use environment::EnvironmentLight;
+
+use super::sampling::{Distribution1d, uniform_triangle};
 use super::shading::vertex_uv;
 use super::surface::{interpolate_with_error, transform_point_with_error};
 use crate::scene::{ColorSpace, LightKind, Scene, TextureRef};
@@ -21,6 +25,8 @@ struct EmissiveTriangle {
     normal: Vec3,
     area: f32,
     radiance: Vec3,
+    /// The material's emitted power per unit area (W/m²).
+    exitance: f32,
     double_sided: bool,
     /// The emissive texture and the triangle's coordinates in it, if the emission varies.
     texture: Option<(TextureRef, [Vec2; 3])>,
@@ -49,27 +55,42 @@ pub struct LightSample {
     pub is_delta: bool,
 }
 
-/// All emissive triangles and punctual lights of a scene, and the distributions used to
-/// pick them.
+/// One light of a [`LightSet`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Light {
+    /// An emissive triangle, by index into the set's triangles.
+    Triangle(usize),
+    /// A punctual light, by index into the scene's lights.
+    Punctual(usize),
+    /// The environment.
+    Environment,
+}
+
+/// All emissive triangles and punctual lights of a scene and its environment, and the
+/// distributions used to pick them.
 pub struct LightSet {
     triangles: Vec<EmissiveTriangle>,
     punctual: Vec<LightKind>,
-    /// Over the triangles, then the punctual lights.
+    environment: Option<EnvironmentLight>,
+    /// What each entry of `distribution` is.
+    lights: Vec<Light>,
+    /// Over `lights`, by power.
     distribution: Distribution1d,
+    /// Index of the environment in `lights`, if it sends light.
+    environment_index: Option<usize>,
     /// Over the punctual lights alone, for estimators that find area lights by hitting them.
     punctual_distribution: Distribution1d,
-    /// Radius of a sphere around the scene's geometry: directional lights are sampled from
-    /// beyond it, and their power is what crosses its disc.
+    /// Radius of a sphere around the scene's geometry: directional lights and the
+    /// environment are sampled from beyond it, and their power is what crosses its disc.
     scene_radius: f32,
     scene_center: Vec3,
-    /// Constant radiance from directions that miss the scene.
-    environment: Vec3,
     /// For each instance, the index of its mesh's first triangle in `triangles`, if emissive.
     first_of_instance: Vec<Option<u32>>,
 }
 
 impl LightSet {
-    /// Collects the emissive triangles of every instance.
+    /// Collects the emissive triangles of every instance, the punctual lights and the
+    /// environment.
     pub fn build(scene: &Scene) -> LightSet {
         let mut triangles = Vec::new();
         let mut first_of_instance = Vec::with_capacity(scene.instances.len());
@@ -107,6 +128,7 @@ impl LightSet {
                     },
                     area: if usable { area } else { 0.0 },
                     radiance: material.emission,
+                    exitance: material.exitance(),
                     double_sided: material.double_sided,
                     texture: texture.map(|r| {
                         (
@@ -124,44 +146,63 @@ impl LightSet {
             (bounds.center(), 0.5 * bounds.extent().length())
         };
         let punctual: Vec<LightKind> = scene.lights.iter().map(|l| l.kind).collect();
-        let punctual_weights: Vec<f32> = punctual
-            .iter()
-            .map(|l| punctual_power(l, scene_radius))
-            .collect();
-        // A constant environment sends π·L per unit area onto the scene's bounding disc from
-        // each side it is seen; what matters is that it competes fairly with the others.
-        let environment = scene.environment;
-        let environment_weight = if environment.max_element() > 0.0 {
-            let radius = scene_radius.max(1e-3);
-            PI * PI * radius * radius * environment.element_sum() / 3.0
-        } else {
-            0.0
+        let environment = scene
+            .environment
+            .as_ref()
+            .filter(|e| !e.is_black())
+            .map(EnvironmentLight::new);
+        let mut lights: Vec<Light> = (0..triangles.len()).map(Light::Triangle).collect();
+        lights.extend((0..punctual.len()).map(Light::Punctual));
+        let environment_index = environment.as_ref().map(|_| {
+            lights.push(Light::Environment);
+            lights.len() - 1
+        });
+        let mut set = LightSet {
+            triangles,
+            punctual,
+            environment,
+            lights,
+            distribution: Distribution1d::new(Vec::new()),
+            environment_index,
+            punctual_distribution: Distribution1d::new(Vec::new()),
+            scene_radius,
+            scene_center,
+            first_of_instance,
         };
         // A textured emitter counts with its texture's mean.
         let mut texture_means = HashMap::new();
-        let weights = triangles
-            .iter()
-            .map(|t| {
-                let sides = if t.double_sided { 2.0 } else { 1.0 };
-                let scale = t.texture.map_or(Vec3::ONE, |(r, _)| {
-                    *texture_means.entry(r.texture).or_insert_with(|| {
-                        scene.textures[r.texture].mean(ColorSpace::Srgb).truncate()
-                    })
-                });
-                t.area * sides * PI * (t.radiance * scale).element_sum() / 3.0
+        let mut texture_mean = |r: TextureRef| {
+            *texture_means.entry(r.texture).or_insert_with(|| {
+                let mean = scene.textures[r.texture].mean(ColorSpace::Srgb);
+                mean.truncate().element_sum() / 3.0
             })
-            .chain(punctual_weights.iter().copied())
-            .chain(std::iter::once(environment_weight))
+        };
+        let weights = set
+            .lights
+            .iter()
+            .map(|&light| set.power(light, &mut texture_mean))
             .collect();
-        LightSet {
-            triangles,
-            punctual,
-            distribution: Distribution1d::new(weights),
-            punctual_distribution: Distribution1d::new(punctual_weights),
-            scene_radius,
-            scene_center,
-            environment,
-            first_of_instance,
+        set.distribution = Distribution1d::new(weights);
+        set.punctual_distribution = Distribution1d::new(
+            set.punctual.iter().map(|l| l.power(scene_radius)).collect(),
+        );
+        set
+    }
+
+    /// Emitted power of one light (W, mean over channels), for choosing among them; a
+    /// textured triangle's scaled by its texture's mean, `texture_mean`.
+    fn power(&self, light: Light, texture_mean: &mut impl FnMut(TextureRef) -> f32) -> f32 {
+        match light {
+            Light::Triangle(i) => {
+                let t = &self.triangles[i];
+                let scale = t.texture.map_or(1.0, |(r, _)| texture_mean(r));
+                t.area * t.exitance * scale
+            }
+            Light::Punctual(i) => self.punctual[i].power(self.scene_radius),
+            Light::Environment => self
+                .environment
+                .as_ref()
+                .map_or(0.0, |e| e.environment().power(self.scene_radius)),
         }
     }
 
@@ -185,17 +226,33 @@ impl LightSet {
         self.distribution.total()
     }
 
-    /// Draws a point on a light for shading point `p`: a triangle by power, then a uniform
-    /// point on it; the area density is turned into solid angle by distance²/|cos θ_light|.
+    /// The environment, if it sends any light.
+    pub fn environment_light(&self) -> Option<&EnvironmentLight> {
+        self.environment.as_ref()
+    }
+
+    /// Draws a point on a light for shading point `p`: a light by power, then a point on it
+    /// by that light's own rule.
     pub fn sample(&self, scene: &Scene, p: Vec3, u_light: f32, u: Vec2) -> Option<LightSample> {
         let (index, pmf) = self.distribution.sample(u_light)?;
-        let Some(tri) = self.triangles.get(index) else {
-            let punctual = index - self.triangles.len();
-            if punctual == self.punctual.len() {
-                return self.sample_environment(pmf, p, u);
-            }
-            return self.sample_punctual_light(punctual, pmf, p);
-        };
+        match self.lights[index] {
+            Light::Triangle(i) => self.sample_triangle(scene, i, pmf, p, u),
+            Light::Punctual(i) => self.sample_punctual_light(i, pmf, p),
+            Light::Environment => self.sample_environment(pmf, p, u),
+        }
+    }
+
+    /// A uniform point on triangle `index`; the area density is turned into solid angle by
+    /// distance²/|cos θ_light|.
+    fn sample_triangle(
+        &self,
+        scene: &Scene,
+        index: usize,
+        pmf: f32,
+        p: Vec3,
+        u: Vec2,
+    ) -> Option<LightSample> {
+        let tri = &self.triangles[index];
         let b = uniform_triangle(u);
         let (point, point_error) = interpolate_with_error(tri.corners, [1.0 - b.x - b.y, b.x, b.y]);
         let to_light = point - p;
@@ -233,27 +290,40 @@ impl LightSet {
         })
     }
 
-    /// The constant environment: a uniform direction on the sphere, from beyond the scene.
+    /// A direction towards the environment, as a point beyond the scene.
     fn sample_environment(&self, pmf: f32, p: Vec3, u: Vec2) -> Option<LightSample> {
-        let wi = uniform_sphere(u);
-        let far = 2.0 * self.scene_radius + p.distance(self.scene_center) + 1.0;
+        let (wi, radiance, pdf) = self.environment.as_ref()?.sample(u)?;
+        let far = self.beyond_the_scene(p);
         Some(LightSample {
             point: p + far * wi,
             point_error: Vec3::ZERO,
             normal: -wi,
             wi,
             distance: far,
-            radiance: self.environment,
-            pdf: pmf / (4.0 * PI),
+            radiance,
+            pdf: pmf * pdf,
             is_delta: false,
         })
     }
 
-    /// Radiance of the environment along a ray that left the scene, and the solid-angle
-    /// density with which [`LightSet::sample`] would have picked that direction.
-    pub fn environment(&self) -> (Vec3, f32) {
-        let index = self.triangles.len() + self.punctual.len();
-        (self.environment, self.distribution.pmf(index) / (4.0 * PI))
+    /// A distance from `p` that takes a segment past all of the scene.
+    fn beyond_the_scene(&self, p: Vec3) -> f32 {
+        2.0 * self.scene_radius + p.distance(self.scene_center) + 1.0
+    }
+
+    /// Radiance of the environment seen along `direction` by a ray that left the scene, and
+    /// the solid-angle density with which [`LightSet::sample`] would have drawn it.
+    pub fn environment(&self, direction: Vec3) -> (Vec3, f32) {
+        match (&self.environment, self.environment_index) {
+            (Some(e), Some(index)) => {
+                let direction = direction.normalize();
+                (
+                    e.radiance(direction),
+                    self.distribution.pmf(index) * e.pdf(direction),
+                )
+            }
+            _ => (Vec3::ZERO, 0.0),
+        }
     }
 
     /// Draws a punctual light alone, by power, for shading point `p`.
@@ -280,8 +350,7 @@ impl LightSet {
                 irradiance,
             } => {
                 // From beyond the scene, so the shadow ray crosses all of it.
-                let far = 2.0 * self.scene_radius + p.distance(self.scene_center) + 1.0;
-                (p - far * direction, irradiance)
+                (p - self.beyond_the_scene(p) * direction, irradiance)
             }
         };
         let distance = point.distance(p);
@@ -310,26 +379,5 @@ impl LightSet {
             return 0.0;
         }
         self.distribution.pmf(index) / tri.area * distance * distance / cos_light.abs()
-    }
-}
-
-/// Emitted power of a punctual light, mean over channels (W), for choosing lights: a spot
-/// counts its cone up to halfway through the falloff; a directional light, what crosses the
-/// scene's bounding disc.
-fn punctual_power(light: &LightKind, scene_radius: f32) -> f32 {
-    match *light {
-        LightKind::Point { intensity, .. } => 4.0 * PI * intensity.element_sum() / 3.0,
-        LightKind::Spot {
-            intensity,
-            cos_inner,
-            cos_outer,
-            ..
-        } => {
-            let solid_angle = 2.0 * PI * (1.0 - 0.5 * (cos_inner + cos_outer));
-            solid_angle * intensity.element_sum() / 3.0
-        }
-        LightKind::Directional { irradiance, .. } => {
-            PI * scene_radius * scene_radius * irradiance.element_sum() / 3.0
-        }
     }
 }

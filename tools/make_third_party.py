@@ -1,0 +1,134 @@
+"""Writes small models the way other tools write the files users download: no lights, no
+camera. Run with a Python that has `trimesh`, `pygltflib` and `usd-core` (PyPI):
+
+    python3 -m venv /tmp/tp && /tmp/tp/bin/pip install trimesh pygltflib usd-core numpy
+    /tmp/tp/bin/python tools/make_third_party.py tests/scenes/third_party
+
+- `trimesh_shapes.glb`: trimesh's glTF exporter, an icosphere on a box with colours.
+- `pygltflib_plate.gltf`: a flat square lying in the ground plane (Y up), written
+  accessor by accessor with pygltflib, as a flat object such as a watch would be.
+- `usd_core_disc.usda`: Pixar's USD library, a thin Z-up cylinder (a coin) with a
+  UsdPreviewSurface bound.
+"""
+
+import base64
+import struct
+import sys
+from pathlib import Path
+
+import numpy as np
+
+
+def trimesh_shapes(out: Path) -> None:
+    import trimesh
+
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=0.5)
+    ball.apply_translation([0.0, 1.0, 0.0])
+    ball.visual.vertex_colors = [200, 60, 40, 255]
+    box = trimesh.creation.box(extents=[1.6, 1.0, 1.0])
+    box.visual.vertex_colors = [90, 140, 200, 255]
+    trimesh.Scene([ball, box]).export(out / "trimesh_shapes.glb")
+
+
+def pygltflib_plate(out: Path) -> None:
+    import pygltflib as g
+
+    positions = np.array(
+        [[-1, 0, -1], [1, 0, -1], [1, 0, 1], [-1, 0, 1]], dtype=np.float32
+    )
+    indices = np.array([0, 2, 1, 0, 3, 2], dtype=np.uint16)
+    blob = positions.tobytes() + indices.tobytes()
+    gltf = g.GLTF2(
+        scene=0,
+        scenes=[g.Scene(nodes=[0])],
+        nodes=[g.Node(mesh=0, name="plate")],
+        meshes=[
+            g.Mesh(
+                primitives=[
+                    g.Primitive(
+                        attributes=g.Attributes(POSITION=0), indices=1, material=0
+                    )
+                ]
+            )
+        ],
+        materials=[
+            g.Material(
+                pbrMetallicRoughness=g.PbrMetallicRoughness(
+                    baseColorFactor=[0.9, 0.8, 0.3, 1.0],
+                    metallicFactor=0.0,
+                    roughnessFactor=0.6,
+                ),
+                doubleSided=True,
+            )
+        ],
+        accessors=[
+            g.Accessor(
+                bufferView=0,
+                componentType=g.FLOAT,
+                count=4,
+                type=g.VEC3,
+                min=[-1.0, 0.0, -1.0],
+                max=[1.0, 0.0, 1.0],
+            ),
+            g.Accessor(
+                bufferView=1, componentType=g.UNSIGNED_SHORT, count=6, type=g.SCALAR
+            ),
+        ],
+        bufferViews=[
+            g.BufferView(buffer=0, byteOffset=0, byteLength=positions.nbytes),
+            g.BufferView(
+                buffer=0, byteOffset=positions.nbytes, byteLength=indices.nbytes
+            ),
+        ],
+        buffers=[
+            g.Buffer(
+                byteLength=len(blob),
+                uri="data:application/octet-stream;base64,"
+                + base64.b64encode(blob).decode(),
+            )
+        ],
+    )
+    gltf.save(str(out / "pygltflib_plate.gltf"))
+
+
+def usd_core_disc(out: Path) -> None:
+    from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
+
+    stage = Usd.Stage.CreateNew(str(out / "usd_core_disc.usda"))
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    root = UsdGeom.Xform.Define(stage, "/Coin")
+    stage.SetDefaultPrim(root.GetPrim())
+    segments, radius, half = 48, 1.0, 0.08
+    points, counts, indices = [], [], []
+    for z in (-half, half):
+        for i in range(segments):
+            a = 2 * np.pi * i / segments
+            points.append(Gf.Vec3f(radius * np.cos(a), radius * np.sin(a), z))
+    for i in range(segments):
+        j = (i + 1) % segments
+        counts.append(4)
+        indices += [i, j, segments + j, segments + i]
+    counts += [segments, segments]
+    indices += list(reversed(range(segments))) + [segments + i for i in range(segments)]
+    mesh = UsdGeom.Mesh.Define(stage, "/Coin/Disc")
+    mesh.CreatePointsAttr(points)
+    mesh.CreateFaceVertexCountsAttr(counts)
+    mesh.CreateFaceVertexIndicesAttr(indices)
+    material = UsdShade.Material.Define(stage, "/Coin/Gold")
+    shader = UsdShade.Shader.Define(stage, "/Coin/Gold/Surface")
+    shader.CreateIdAttr("UsdPreviewSurface")
+    shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set((1.0, 0.78, 0.34))
+    shader.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(1.0)
+    shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(0.3)
+    material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+    UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(material)
+    stage.GetRootLayer().Save()
+
+
+if __name__ == "__main__":
+    out = Path(sys.argv[1])
+    out.mkdir(parents=True, exist_ok=True)
+    trimesh_shapes(out)
+    pygltflib_plate(out)
+    usd_core_disc(out)
