@@ -69,7 +69,11 @@ pub fn describe(scene: &Scene, warnings: &[String]) -> String {
                     vector(e.mean_radiance())
                 ),
             };
-            let hidden = if e.camera_visible { "" } else { ", hidden from the camera" };
+            let hidden = if e.camera_visible {
+                ""
+            } else {
+                ", hidden from the camera"
+            };
             let _ = writeln!(out, "environment ({}): {what}{hidden}", e.source);
         }
     }

@@ -11,6 +11,9 @@ enum Expect {
     Error(&'static str),
     /// Exit code 0, an image, and a warning naming the file that contains the text.
     Warning(&'static str),
+    /// Exit code 0, an image, and a note (what gridtrace chose for the user) naming the
+    /// file that contains the text.
+    Note(&'static str),
 }
 
 const CASES: &[(&str, Expect)] = &[
@@ -78,7 +81,7 @@ const CASES: &[(&str, Expect)] = &[
     ),
     (
         "no_emitters.gltf",
-        Expect::Warning("the scene has no emitters"),
+        Expect::Note("the scene has no lights; lighting it with the default studio environment"),
     ),
     (
         "truncated.ply",
@@ -161,12 +164,16 @@ fn every_bad_input_has_its_exact_outcome() {
                 );
                 assert!(!out.exists(), "{name}: an image was written");
             }
-            Expect::Warning(text) => {
+            Expect::Warning(text) | Expect::Note(text) => {
+                let prefix = match expect {
+                    Expect::Note(_) => "note: ",
+                    _ => "warning: ",
+                };
                 assert_eq!(code, Some(0), "{name}: {err}");
-                let warning = err.lines().find(|l| l.contains(text));
+                let line = err.lines().find(|l| l.contains(text));
                 assert!(
-                    warning.is_some_and(|w| w.starts_with("warning: ") && w.contains(name)),
-                    "{name}: no warning with '{text}':\n{err}"
+                    line.is_some_and(|w| w.starts_with(prefix) && w.contains(name)),
+                    "{name}: no {prefix}line with '{text}':\n{err}"
                 );
                 assert!(image::open(&out).is_ok(), "{name}: no readable image");
             }

@@ -194,25 +194,39 @@ fn errors_are_one_line_with_exit_code_2() {
 }
 
 #[test]
-fn a_scene_without_emitters_renders_black_with_a_warning() {
+fn a_scene_without_emitters_is_lit_by_the_studio_light_unless_asked_for_black() {
     let dir = tempfile::tempdir().unwrap();
     let scene = common::write_gltf(dir.path(), "dark.gltf", &common::quad_document());
-    let out = gridtrace(
-        &[
+    let render = |extra: &[&str], output: &str| {
+        let mut args = vec![
             scene.to_str().unwrap(),
             "-o",
-            "dark.png",
+            output,
             "--width",
             "8",
             "--spp",
-            "1",
-        ],
-        dir.path(),
+            "4",
+        ];
+        args.extend_from_slice(extra);
+        let out = gridtrace(&args, dir.path());
+        assert!(out.status.success(), "{}", stderr(&out));
+        let png = image::open(dir.path().join(output)).unwrap().to_rgb8();
+        (stderr(&out), png)
+    };
+    let (err, lit) = render(&[], "lit.png");
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("note: ") && l.contains("default studio environment")),
+        "{err}"
     );
-    assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stderr(&out).contains("no emitters"), "{}", stderr(&out));
-    let png = image::open(dir.path().join("dark.png")).unwrap().to_rgb8();
-    assert!(png.pixels().all(|p| p.0 == [0, 0, 0]));
+    // Every pixel sees the quad or the studio's grey sky.
+    assert!(lit.pixels().all(|p| p.0.iter().all(|&c| c > 20)), "{lit:?}");
+    let (err, dark) = render(&["--environment", "none"], "dark.png");
+    assert!(
+        err.contains("warning: ") && err.contains("no emitters"),
+        "{err}"
+    );
+    assert!(dark.pixels().all(|p| p.0 == [0, 0, 0]));
 }
 
 #[test]

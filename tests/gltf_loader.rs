@@ -140,17 +140,19 @@ fn without_a_camera_a_default_one_frames_the_scene() {
         .scene;
     let camera = choose_camera(&scene, None, None, None).unwrap();
     let eye = camera.world_from_camera.transform_point3(Vec3::ZERO);
-    assert!(
-        eye.z > 1.0 && eye.x.abs() < 1e-6 && eye.y.abs() < 1e-6,
-        "{eye}"
-    );
+    // A three-quarter view: in front (+Z), to the right (+X) and above (+Y).
+    assert!(eye.z > 1.0 && eye.x > 0.3 && eye.y > 0.3, "{eye}");
     // The quad's corners are inside the view.
     let Projection::Perspective { yfov, .. } = camera.projection else {
         panic!()
     };
-    for corner in [Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, -1.0, 0.0)] {
-        let d = corner - eye;
-        assert!((d.y / -d.z).abs() < (0.5 * yfov).tan() && (d.x / -d.z).abs() < (0.5 * yfov).tan());
+    let camera_from_world = camera.world_from_camera.inverse();
+    for x in [-1.0, 1.0] {
+        for y in [-1.0, 1.0] {
+            let d = camera_from_world.transform_point3(Vec3::new(x, y, 0.0));
+            let half = (0.5 * yfov).tan();
+            assert!(d.z < 0.0 && (d.y / -d.z).abs() < half && (d.x / -d.z).abs() < half);
+        }
     }
 }
 

@@ -105,10 +105,7 @@ const CASES: &[(&str, Expect)] = &[
         Expect::Error("the mesh its header declares needs 7.2 GB"),
     ),
     // Time.
-    (
-        "ply_big_polygon.ply",
-        Expect::Warning("the scene has no emitters"),
-    ),
+    ("ply_big_polygon.ply", Expect::Image),
     (
         "usd_big_polygon.usda",
         Expect::Warning("face 0 is a concave polygon of 200000 corners"),

@@ -518,10 +518,12 @@ fn a_hand_written_stage_loads_as_usd_defines_it() {
         }
         other => panic!("{other:?}"),
     }
+    let environment = scene.environment.as_ref().expect("the dome light");
+    assert!(environment.map.is_none());
     assert!(
-        close(scene.environment, Vec3::new(0.5, 0.25, 0.125)),
+        close(environment.tint, Vec3::new(0.5, 0.25, 0.125)),
         "{}",
-        scene.environment
+        environment.tint
     );
     // A disk of radius 50 cm, not normalized: radiance = intensity, area ≈ π/4 m².
     let disk = world_triangles(scene, "/World/Disk");

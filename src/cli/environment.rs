@@ -41,7 +41,9 @@ fn colour(c: Vec3, text: &str) -> Result<EnvironmentChoice, String> {
     if c.is_finite() && c.min_element() >= 0.0 {
         Ok(EnvironmentChoice::Constant(c))
     } else {
-        Err(format!("'{text}': radiance must be finite and not negative"))
+        Err(format!(
+            "'{text}': radiance must be finite and not negative"
+        ))
     }
 }
 
@@ -103,8 +105,8 @@ pub fn apply_environment(
     // Without an environment, escaping camera rays are black with alpha 0 already.
     if let Some(e) = &mut scene.environment {
         e.tint *= args.environment_strength;
-        e.world_from_map = Mat3::from_rotation_y(args.environment_rotation.to_radians())
-            * e.world_from_map;
+        e.world_from_map =
+            Mat3::from_rotation_y(args.environment_rotation.to_radians()) * e.world_from_map;
         if args.hide_environment {
             e.camera_visible = false;
         }

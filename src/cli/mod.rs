@@ -122,8 +122,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         eprintln!("warning: {warning}");
     }
     let mut scene = loaded.scene;
-    let (environment_note, environment_label) =
-        apply_environment(&mut scene, args, scene_path)?;
+    let (environment_note, environment_label) = apply_environment(&mut scene, args, scene_path)?;
     let triangles = scene.instanced_triangle_count() as u64;
     if triangles > args.max_triangles {
         bail!(

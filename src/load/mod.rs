@@ -163,12 +163,13 @@ fn load_by_format(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadErro
 /// sRGB) named on the command line, within the memory budget.
 pub fn load_environment_map(path: &Path) -> Result<EnvironmentMap, LoadError> {
     let name = path.display().to_string();
-    let bytes = access::read_regular_file(path, &name, crate::limits::memory_budget()).map_err(
-        |e| LoadError::Invalid {
-            path: path.to_path_buf(),
-            what: e.to_string(),
-        },
-    )?;
+    let bytes =
+        access::read_regular_file(path, &name, crate::limits::memory_budget()).map_err(|e| {
+            LoadError::Invalid {
+                path: path.to_path_buf(),
+                what: e.to_string(),
+            }
+        })?;
     images::decode_environment(name, &bytes).map_err(|why| LoadError::Invalid {
         path: path.to_path_buf(),
         what: format!("environment map {why}"),

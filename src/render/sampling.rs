@@ -342,7 +342,13 @@ mod tests {
     fn distribution_2d_matches_its_density_chi_square() {
         let (w, h) = (6usize, 4usize);
         let weights: Vec<f32> = (0..w * h)
-            .map(|i| if i % 7 == 3 { 0.0 } else { 1.0 + (i * i % 5) as f32 })
+            .map(|i| {
+                if i % 7 == 3 {
+                    0.0
+                } else {
+                    1.0 + (i * i % 5) as f32
+                }
+            })
             .collect();
         let d = Distribution2d::new(&weights, w, h);
         let total: f32 = weights.iter().sum();
@@ -351,7 +357,11 @@ mod tests {
         let mut r = Rng::new(13, 1);
         for _ in 0..samples {
             let (p, density) = d.sample(r.uniform2()).unwrap();
-            assert!((density - d.pdf(p)).abs() <= 1e-4 * density, "{density} vs {}", d.pdf(p));
+            assert!(
+                (density - d.pdf(p)).abs() <= 1e-4 * density,
+                "{density} vs {}",
+                d.pdf(p)
+            );
             let (x, y) = ((p.x * bx as f32) as usize, (p.y * by as f32) as usize);
             counts[y.min(by - 1) * bx + x.min(bx - 1)] += 1.0;
         }

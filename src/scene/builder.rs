@@ -103,9 +103,7 @@ impl SceneBuilder {
         match &mut self.scene.environment {
             Some(e) if e.map.is_none() => e.tint += radiance,
             Some(_) => return false,
-            None => {
-                self.scene.environment = Some(Environment::constant(radiance, "environment"))
-            }
+            None => self.scene.environment = Some(Environment::constant(radiance, "environment")),
         }
         true
     }

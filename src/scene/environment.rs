@@ -221,7 +221,11 @@ mod tests {
         assert!((map_uv(Vec3::X) - Vec2::new(0.25, 0.5)).length() < 1e-6);
         assert!(map_uv(Vec3::Y).y.abs() < 1e-6);
         assert!((map_uv(Vec3::NEG_Y).y - 1.0).abs() < 1e-6);
-        for uv in [Vec2::new(0.1, 0.2), Vec2::new(0.7, 0.9), Vec2::new(0.5, 0.5)] {
+        for uv in [
+            Vec2::new(0.1, 0.2),
+            Vec2::new(0.7, 0.9),
+            Vec2::new(0.5, 0.5),
+        ] {
             let back = map_uv(map_direction(uv));
             assert!((back - uv).length() < 1e-5, "{uv} -> {back}");
         }

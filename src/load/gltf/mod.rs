@@ -542,7 +542,10 @@ impl GltfLoader {
             indices,
             material,
         };
-        let normal_uvs = primitive.material().index().and_then(|m| self.normal_mapped.get(m).copied().flatten());
+        let normal_uvs = primitive
+            .material()
+            .index()
+            .and_then(|m| self.normal_mapped.get(m).copied().flatten());
         if let Some(set) = normal_uvs
             && mesh.tangents.is_empty()
             && !generate_tangents(&mut mesh, set)

@@ -48,7 +48,10 @@ impl UsdLoader {
             ));
             return;
         }
-        let file = self.get(prim, "inputs:texture:file").as_ref().and_then(as_asset);
+        let file = self
+            .get(prim, "inputs:texture:file")
+            .as_ref()
+            .and_then(as_asset);
         let Some(file) = file.filter(|f| !f.is_empty()) else {
             if !self.builder.add_environment(tint) {
                 self.warn(format!(
@@ -92,9 +95,12 @@ impl UsdLoader {
     /// The lamp's camera visibility where the file says it (Karma's `renderlightgeo`,
     /// RenderMan's camera visibility primvar); `None` when it does not.
     fn camera_visibility(&self, prim: &sdf::Path) -> Option<bool> {
-        ["karma:light:renderlightgeo", "primvars:ri:attributes:visibility:camera"]
-            .iter()
-            .find_map(|name| self.get(prim, name).as_ref().and_then(as_bool))
+        [
+            "karma:light:renderlightgeo",
+            "primvars:ri:attributes:visibility:camera",
+        ]
+        .iter()
+        .find_map(|name| self.get(prim, name).as_ref().and_then(as_bool))
     }
 
     pub(super) fn add_camera(&mut self, prim: &sdf::Path, world: Mat4) {

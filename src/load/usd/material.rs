@@ -10,7 +10,8 @@ use crate::limits::memory_budget;
 use crate::load::access::read_regular_file;
 use crate::load::images::{decode_environment, decode_texture};
 use crate::scene::{
-    AlphaMode, ChannelRef, ColorSpace, EnvironmentMap, Material, MaterialTextures, Pbr, TextureRef, Wrap, f0_of_ior,
+    AlphaMode, ChannelRef, ColorSpace, EnvironmentMap, Material, MaterialTextures, Pbr, TextureRef,
+    Wrap, f0_of_ior,
 };
 
 impl UsdLoader {
@@ -350,7 +351,9 @@ impl UsdLoader {
         match map {
             Ok(map) => Some(map),
             Err(why) => {
-                self.warn(format!("{prim}: dome texture {why}; the dome light is skipped"));
+                self.warn(format!(
+                    "{prim}: dome texture {why}; the dome light is skipped"
+                ));
                 None
             }
         }

@@ -154,7 +154,11 @@ mod tests {
         let mut r = Rng::new(17, 3);
         for _ in 0..samples {
             let (wi, _, pdf) = light.sample(r.uniform2()).unwrap();
-            assert!((pdf - light.pdf(wi)).abs() <= 2e-3 * pdf, "{pdf} vs {}", light.pdf(wi));
+            assert!(
+                (pdf - light.pdf(wi)).abs() <= 2e-3 * pdf,
+                "{pdf} vs {}",
+                light.pdf(wi)
+            );
             counts[bin(wi)] += 1.0;
         }
         // Expected counts: the pdf integrated over each bin by a fine midpoint rule.
@@ -180,7 +184,10 @@ mod tests {
         }
         // ~500 degrees of freedom: the 99.9th percentile is below dof + 4.5·√(2·dof).
         let limit = dof as f64 + 4.5 * (2.0 * dof as f64).sqrt();
-        assert!(chi2 < limit, "chi2 = {chi2} over {dof} bins (limit {limit})");
+        assert!(
+            chi2 < limit,
+            "chi2 = {chi2} over {dof} bins (limit {limit})"
+        );
     }
 
     #[test]

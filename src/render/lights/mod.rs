@@ -183,9 +183,8 @@ impl LightSet {
             .map(|&light| set.power(light, &mut texture_mean))
             .collect();
         set.distribution = Distribution1d::new(weights);
-        set.punctual_distribution = Distribution1d::new(
-            set.punctual.iter().map(|l| l.power(scene_radius)).collect(),
-        );
+        set.punctual_distribution =
+            Distribution1d::new(set.punctual.iter().map(|l| l.power(scene_radius)).collect());
         set
     }
 
