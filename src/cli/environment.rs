@@ -8,9 +8,9 @@ use anyhow::{Context, Result};
 use glam::{Mat3, Vec3};
 
 use super::args::Args;
-use crate::load::load_environment_map;
+use crate::load::load_environment;
 use crate::record::sha256_file;
-use crate::scene::{Environment, Scene, blender_world_rotation};
+use crate::scene::{Environment, Scene};
 
 /// What `--environment` asked for.
 #[derive(Clone, Debug, PartialEq)]
@@ -81,14 +81,8 @@ pub fn apply_environment(
             format!("{},{},{}", c.x, c.y, c.z)
         }
         Some(EnvironmentChoice::File(path)) => {
-            let map = load_environment_map(path)?;
+            scene.environment = Some(load_environment(path)?);
             let sha = sha256_file(path).with_context(|| format!("{}", path.display()))?;
-            scene.environment = Some(Environment::from_map(
-                map,
-                Vec3::ONE,
-                blender_world_rotation(0.0),
-                format!("--environment {}", path.display()),
-            ));
             format!("{} sha256={sha}", path.display())
         }
         None if !scene.has_emitters() && scene.instanced_triangle_count() > 0 => {

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 use crate::accel::Triangle;
 use crate::record::Dependency;
-use crate::scene::{EnvironmentMap, Scene};
+use crate::scene::{Environment, EnvironmentMap, Scene, blender_world_rotation};
 
 /// A loaded scene and the warnings met on the way (things skipped or approximated).
 #[derive(Debug)]
@@ -159,8 +159,20 @@ fn load_by_format(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadErro
     }
 }
 
+/// The environment of a latitude–longitude map file named on the command line, oriented as
+/// Blender's world shows it (see [`blender_world_rotation`]).
+pub fn load_environment(path: &Path) -> Result<Environment, LoadError> {
+    let map = load_environment_map(path)?;
+    Ok(Environment::from_map(
+        map,
+        glam::Vec3::ONE,
+        blender_world_rotation(0.0),
+        format!("--environment {}", path.display()),
+    ))
+}
+
 /// Reads a latitude–longitude environment map (`.hdr`, `.exr`, or an 8-bit image taken as
-/// sRGB) named on the command line, within the memory budget.
+/// sRGB), within the memory budget.
 pub fn load_environment_map(path: &Path) -> Result<EnvironmentMap, LoadError> {
     let name = path.display().to_string();
     let bytes =

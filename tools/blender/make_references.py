@@ -379,7 +379,7 @@ def _enum_items(node, prop):
     return {item.identifier for item in node.bl_rna.properties[prop].enum_items}
 
 
-def configure_cycles(scene, samples, seed):
+def configure_cycles(scene, samples, seed, keep_world=False):
     scene.render.engine = "CYCLES"
     scene.render.resolution_x = SIZE
     scene.render.resolution_y = SIZE
@@ -416,7 +416,7 @@ def configure_cycles(scene, samples, seed):
     c.min_light_bounces = 0
     c.min_transparent_bounces = 0
     scene.render.threads_mode = "AUTO"
-    if scene.world is not None:
+    if scene.world is not None and not keep_world:
         scene.world = None
     for obj in scene.objects:
         if obj.type == "MESH":
@@ -426,8 +426,8 @@ def configure_cycles(scene, samples, seed):
             obj.cycles.shadow_terminator_offset = 0.0
 
 
-def render(scene, path, samples, seed):
-    configure_cycles(scene, samples, seed)
+def render(scene, path, samples, seed, keep_world=False):
+    configure_cycles(scene, samples, seed, keep_world)
     scene.render.filepath = path
     start = time.time()
     bpy.ops.render.render(write_still=True)

@@ -34,12 +34,11 @@ impl UsdLoader {
         colour * intensity * exposure.exp2()
     }
 
-    /// A `DomeLight`: radiance intensity × 2^exposure × color from every direction the
-    /// scene leaves open, times its latitude–longitude `texture:file` if it has one. The map
-    /// is read in the OpenEXR convention, its pole along the dome's +Y (`DomeLight`) or,
-    /// for `DomeLight_1`, along the stage's up axis unless `poleAxis` says Y, then placed by
-    /// the dome's transform.
-    pub(super) fn add_dome(&mut self, prim: &sdf::Path, type_name: &str, world: Mat4) {
+    /// A `DomeLight` or `DomeLight_1`: radiance intensity × 2^exposure × color from every
+    /// direction the scene leaves open, times its latitude–longitude `texture:file` if it
+    /// has one. The map is read in the OpenEXR convention, its pole turned onto the stage's
+    /// up axis (below), then placed by the dome's transform.
+    pub(super) fn add_dome(&mut self, prim: &sdf::Path, world: Mat4) {
         let where_ = prim.as_str().to_string();
         let tint = self.light_strength(prim);
         if !tint.is_finite() || tint.min_element() < 0.0 {
@@ -71,12 +70,17 @@ impl UsdLoader {
         let Some(map) = self.environment_file(&file, &where_) else {
             return;
         };
-        // The pole: DomeLight_1 aligns it with the stage's up axis by default.
+        // The pole: along the stage's up axis unless `poleAxis` says Y, as usdview (USD
+        // 25.05) and Blender's importer read both DomeLight and DomeLight_1; on a Z-up stage
+        // the map's +Y goes to +Z and its centre column (+Z) to +X, which is also where
+        // Blender's world puts them.
         let pole_axis = self
             .get_token(prim, "poleAxis")
             .unwrap_or_else(|| "scene".into());
-        let pole = if type_name == "DomeLight_1" && pole_axis != "Y" && self.stage_up_is_z() {
-            Mat3::from_rotation_x(std::f32::consts::FRAC_PI_2)
+        let up_is_z = self.stage_up_is_z();
+        let pole_on_z = (up_is_z && pole_axis != "Y") || (!up_is_z && pole_axis == "Z");
+        let pole = if pole_on_z {
+            Mat3::from_cols(Vec3::Y, Vec3::Z, Vec3::X)
         } else {
             Mat3::IDENTITY
         };
@@ -178,11 +182,20 @@ impl UsdLoader {
         let camera_visible = self.camera_visibility(prim).unwrap_or(false);
         let emitter =
             |loader: &mut UsdLoader, positions: Vec<Vec3>, indices: Vec<[u32; 3]>, area: f32| {
+                // The polygons inscribed in a disc or a sphere have a little less area than
+                // the shape (`area`): scaled up, they emit the shape's power.
+                let mesh_area: f32 = indices
+                    .iter()
+                    .map(|t| {
+                        let [a, b, c] = t.map(|i| positions[i as usize]);
+                        0.5 * (b - a).cross(c - a).length()
+                    })
+                    .sum();
                 let radiance = if normalize {
                     strength / (area * area_scale).max(f32::MIN_POSITIVE)
                 } else {
                     strength
-                };
+                } * (area / mesh_area.max(f32::MIN_POSITIVE));
                 let material = loader.builder.add_material(Material {
                     double_sided: false,
                     camera_visible,
@@ -216,11 +229,7 @@ impl UsdLoader {
                 let indices = (0..DISK_SEGMENTS)
                     .map(|i| [0, 1 + i, 1 + (i + 1) % DISK_SEGMENTS])
                     .collect();
-                let area = 0.5
-                    * DISK_SEGMENTS as f32
-                    * r
-                    * r
-                    * (std::f32::consts::TAU / DISK_SEGMENTS as f32).sin();
+                let area = std::f32::consts::PI * r * r;
                 emitter(self, positions, indices, area);
             }
             "SphereLight" => {
@@ -326,8 +335,13 @@ fn uv_sphere(radius: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     for ring in 0..rings {
         for segment in 0..segments {
             let (a, b) = (ring * row + segment, (ring + 1) * row + segment);
-            indices.push([a, b, b + 1]);
-            indices.push([a, b + 1, a + 1]);
+            // At the poles one of the two triangles has no area: leave it out.
+            if ring + 1 < rings {
+                indices.push([a, b, b + 1]);
+            }
+            if ring > 0 {
+                indices.push([a, b + 1, a + 1]);
+            }
         }
     }
     (positions, indices)

@@ -449,7 +449,7 @@ impl UsdLoader {
             "RectLight" | "DiskLight" | "SphereLight" | "DistantLight" => {
                 self.add_light(&path, &type_name, world)
             }
-            "DomeLight" | "DomeLight_1" => self.add_dome(&path, &type_name, world),
+            "DomeLight" | "DomeLight_1" => self.add_dome(&path, world),
             "" | "Xform" | "Scope" | "SkelRoot" => {}
             "Sphere" | "Cube" | "Cylinder" | "Cone" | "Capsule" | "Plane" | "Points"
             | "BasisCurves" | "NurbsCurves" | "NurbsPatch" | "PointInstancer" | "Volume" => self
