@@ -125,11 +125,11 @@ pub struct Args {
     /// oriented as Blender's world shows it; a constant radiance, one number or R,G,B; or
     /// "none". Replaces the scene's own (a USD dome light). [default: the scene's; a neutral
     /// studio light when the scene has no light at all]
-    #[arg(long, value_name = "FILE|R,G,B|none", value_parser = parse_environment)]
+    #[arg(long, value_name = "FILE|R,G,B|none", allow_hyphen_values = true, value_parser = parse_environment)]
     pub environment: Option<EnvironmentChoice>,
 
     /// Multiplies the environment's radiance, whichever it is.
-    #[arg(long, value_name = "FACTOR", default_value_t = 1.0, value_parser = parse_strength)]
+    #[arg(long, value_name = "FACTOR", default_value_t = 1.0, allow_negative_numbers = true, value_parser = parse_strength)]
     pub environment_strength: f32,
 
     /// Turns the environment about the up axis, in degrees (counter-clockwise seen from
