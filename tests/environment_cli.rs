@@ -26,7 +26,15 @@ fn stderr(out: &Output) -> String {
 /// the RGBA pixels.
 fn render(dir: &Path, file: &str, output: &str, extra: &[&str]) -> (String, Vec<[f32; 4]>) {
     let path = scene(file);
-    let mut args = vec![path.as_str(), "-o", output, "--width", "24", "--height", "24"];
+    let mut args = vec![
+        path.as_str(),
+        "-o",
+        output,
+        "--width",
+        "24",
+        "--height",
+        "24",
+    ];
     args.extend_from_slice(&["--spp", "8"]);
     args.extend_from_slice(extra);
     let out = gridtrace(&args, dir);
@@ -36,7 +44,11 @@ fn render(dir: &Path, file: &str, output: &str, extra: &[&str]) -> (String, Vec<
 }
 
 fn mean(pixels: &[[f32; 4]]) -> f64 {
-    pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / (3 * pixels.len()) as f64
+    pixels
+        .iter()
+        .map(|p| (p[0] + p[1] + p[2]) as f64)
+        .sum::<f64>()
+        / (3 * pixels.len()) as f64
 }
 
 /// Files written by other tools (trimesh, pygltflib, Pixar's USD library; see
@@ -60,8 +72,15 @@ fn models_without_lights_or_camera_render_visibly_with_a_note() {
         // The model covers a good part of the frame (alpha 1 where it is hit) and is lit.
         let covered: Vec<[f32; 4]> = pixels.iter().copied().filter(|p| p[3] == 1.0).collect();
         let share = covered.len() as f64 / pixels.len() as f64;
-        assert!((0.1..0.9).contains(&share), "{file}: covers {share:.2} of the frame");
-        assert!(mean(&covered) > 0.1, "{file}: the model is dark ({})", mean(&covered));
+        assert!(
+            (0.1..0.9).contains(&share),
+            "{file}: covers {share:.2} of the frame"
+        );
+        assert!(
+            mean(&covered) > 0.1,
+            "{file}: the model is dark ({})",
+            mean(&covered)
+        );
     }
 }
 
@@ -81,7 +100,10 @@ fn environment_file_strength_rotation_and_hiding() {
     // One light, the same samples: twice the radiance everywhere.
     for (a, b) in base.iter().zip(&strong) {
         for c in 0..3 {
-            assert!((b[c] - 2.0 * a[c]).abs() <= 1e-5 * (1.0 + b[c]), "{a:?} {b:?}");
+            assert!(
+                (b[c] - 2.0 * a[c]).abs() <= 1e-5 * (1.0 + b[c]),
+                "{a:?} {b:?}"
+            );
         }
     }
     let (_, turned) = render(
@@ -103,7 +125,10 @@ fn environment_file_strength_rotation_and_hiding() {
         &["--environment", &hdr, "--environment-rotation", "360"],
     );
     for (a, b) in base.iter().zip(&full_turn) {
-        assert!((0..3).all(|c| (a[c] - b[c]).abs() <= 1e-3 * (1.0 + a[c])), "{a:?} {b:?}");
+        assert!(
+            (0..3).all(|c| (a[c] - b[c]).abs() <= 1e-3 * (1.0 + a[c])),
+            "{a:?} {b:?}"
+        );
     }
     let (_, hidden) = render(
         dir.path(),
@@ -123,9 +148,24 @@ fn environment_file_strength_rotation_and_hiding() {
             assert!(h[3] == a[3] && (0..3).all(|c| h[c] <= a[c]), "{a:?} {h:?}");
         }
     }
-    let (_, grey) = render(dir.path(), model, "grey.exr", &["--environment", "0.5,0.5,0.5"]);
+    let (_, grey) = render(
+        dir.path(),
+        model,
+        "grey.exr",
+        &["--environment", "0.5,0.5,0.5"],
+    );
     let background: Vec<&[f32; 4]> = grey.iter().filter(|p| p[3] == 0.0).collect();
     assert!(!background.is_empty() && background.iter().all(|p| p[..3] == [0.5; 3]));
+    // An OpenEXR map: the one-colour world Blender's USD exporter wrote, (0.3, 0.45, 0.7).
+    let exr = scene("textures/color_4C72B2.exr");
+    let (_, sky) = render(dir.path(), model, "sky.exr", &["--environment", &exr]);
+    let background: Vec<&[f32; 4]> = sky.iter().filter(|p| p[3] == 0.0).collect();
+    assert!(!background.is_empty());
+    for p in background {
+        assert!(
+            (p[0] - 0.3).abs() < 1e-6 && (p[1] - 0.45).abs() < 1e-6 && (p[2] - 0.7).abs() < 1e-6
+        );
+    }
 }
 
 #[test]
@@ -134,10 +174,22 @@ fn bad_environment_options_are_refused_in_one_line() {
     let model = scene("third_party/trimesh_shapes.glb");
     let missing = PathBuf::from("no_such_sky.hdr");
     for (args, expected) in [
-        (vec!["--environment", "1,2"], "neither one number, R,G,B nor a file"),
-        (vec!["--environment", "-1,0,0"], "must be finite and not negative"),
-        (vec!["--environment-strength", "-2"], "not a finite, non-negative number"),
-        (vec!["--environment", missing.to_str().unwrap()], "no_such_sky.hdr"),
+        (
+            vec!["--environment", "1,2"],
+            "neither one number, R,G,B nor a file",
+        ),
+        (
+            vec!["--environment", "-1,0,0"],
+            "must be finite and not negative",
+        ),
+        (
+            vec!["--environment-strength", "-2"],
+            "not a finite, non-negative number",
+        ),
+        (
+            vec!["--environment", missing.to_str().unwrap()],
+            "no_such_sky.hdr",
+        ),
     ] {
         let mut all = vec![model.as_str(), "-o", "x.png", "--spp", "1", "--width", "8"];
         all.extend_from_slice(&args);

@@ -167,6 +167,7 @@ def Xform "World"
 
     def RectLight "Panel"
     {
+        int karma:light:renderlightgeo = 1
         float inputs:intensity = 10
         float inputs:exposure = 1
         float inputs:width = 200
@@ -525,15 +526,24 @@ fn a_hand_written_stage_loads_as_usd_defines_it() {
         "{}",
         environment.tint
     );
-    // A disk of radius 50 cm, not normalized: radiance = intensity, area ≈ π/4 m².
+    // A disk of radius 50 cm, not normalized: radiance = intensity over a disc of π/4 m²;
+    // the inscribed polygon (a little smaller) emits the disc's power.
     let disk = world_triangles(scene, "/World/Disk");
     let area: f32 = disk
         .iter()
         .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
         .sum();
     assert!((area - std::f32::consts::PI / 4.0).abs() < 0.01, "{area}");
-    let disk_material = scene.materials.iter().find(|m| m.name == "/World/Disk");
-    assert_eq!(disk_material.unwrap().emission, Vec3::splat(2.0));
+    let disk_material = scene
+        .materials
+        .iter()
+        .find(|m| m.name == "/World/Disk")
+        .unwrap();
+    let power = disk_material.emission * area;
+    assert!(
+        close(power, Vec3::splat(2.0 * std::f32::consts::PI / 4.0)),
+        "{power}"
+    );
     let warm = scene
         .lights
         .iter()
@@ -557,19 +567,27 @@ fn a_hand_written_stage_loads_as_usd_defines_it() {
         other => panic!("{other:?}"),
     }
     // A sphere light with a radius is a spherical emitter: normalized, its radiance is
-    // intensity over its area (radius 10 cm).
+    // intensity over its area (radius 10 cm), so radiance × area = intensity; the
+    // tessellation (no zero-area triangles at the poles) keeps the sphere's power.
     let globe = scene
         .materials
         .iter()
         .find(|m| m.name == "/World/Globe")
         .unwrap();
-    let expected = 3.0 / (4.0 * std::f32::consts::PI * 0.01);
+    let globe_triangles = world_triangles(scene, "/World/Globe");
+    assert_eq!(globe_triangles.len(), 2 * 16 * 32 - 2 * 32);
+    let area: f32 = globe_triangles
+        .iter()
+        .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
+        .sum();
     assert!(
-        (globe.emission.x / expected - 1.0).abs() < 1e-4,
-        "{}",
+        (globe.emission.x * area / 3.0 - 1.0).abs() < 1e-3,
+        "{} over {area} m²",
         globe.emission
     );
-    assert_eq!(world_triangles(scene, "/World/Globe").len(), 2 * 16 * 32);
+    // Lamps are not seen by camera rays unless the file says so (the panel does).
+    assert!(!globe.camera_visible);
+    assert!(panel.camera_visible);
     // `--camera` finds a USD camera by its prim path.
     let chosen = choose_camera(scene, Some("/World/Cam"), None, None).unwrap();
     assert_eq!(chosen.name, "/World/Cam");
