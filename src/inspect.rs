@@ -247,6 +247,29 @@ fn light_summary(kind: &LightKind) -> String {
             cos_inner.acos().to_degrees(),
             cos_outer.acos().to_degrees()
         ),
+        LightKind::Sphere {
+            position,
+            radius,
+            radiance,
+            spot,
+            camera_visible,
+        } => format!(
+            "sphere at {}, radius {radius}, radiance {}, {} W{}{}",
+            vector(position),
+            vector(radiance),
+            significant(kind.power(0.0)),
+            spot.map_or(String::new(), |(d, inner, outer)| format!(
+                ", cone towards {} {:.1}° to {:.1}°",
+                vector(d),
+                inner.acos().to_degrees(),
+                outer.acos().to_degrees()
+            )),
+            if camera_visible {
+                ""
+            } else {
+                ", hidden from the camera"
+            }
+        ),
         LightKind::Directional {
             direction,
             irradiance,

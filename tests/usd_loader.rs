@@ -566,27 +566,29 @@ fn a_hand_written_stage_loads_as_usd_defines_it() {
         }
         other => panic!("{other:?}"),
     }
-    // A sphere light with a radius is a spherical emitter: normalized, its radiance is
-    // intensity over its area (radius 10 cm), so radiance × area = intensity; the
-    // tessellation (no zero-area triangles at the poles) keeps the sphere's power.
+    // A sphere light with a radius is a sphere lamp (radius 10 cm after the unit change):
+    // normalized, its radiance is intensity over its area.
     let globe = scene
-        .materials
+        .lights
         .iter()
-        .find(|m| m.name == "/World/Globe")
+        .find(|l| l.name == "/World/Globe")
         .unwrap();
-    let globe_triangles = world_triangles(scene, "/World/Globe");
-    assert_eq!(globe_triangles.len(), 2 * 16 * 32 - 2 * 32);
-    let area: f32 = globe_triangles
-        .iter()
-        .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
-        .sum();
-    assert!(
-        (globe.emission.x * area / 3.0 - 1.0).abs() < 1e-3,
-        "{} over {area} m²",
-        globe.emission
-    );
+    let LightKind::Sphere {
+        radius,
+        radiance,
+        spot,
+        camera_visible,
+        ..
+    } = globe.kind
+    else {
+        panic!("{:?}", globe.kind)
+    };
+    assert!((radius - 0.1).abs() < 1e-6, "{radius}");
+    let expected = 3.0 / (4.0 * std::f32::consts::PI * 0.01);
+    assert!((radiance.x / expected - 1.0).abs() < 1e-4, "{radiance}");
+    assert!(spot.is_none());
     // Lamps are not seen by camera rays unless the file says so (the panel does).
-    assert!(!globe.camera_visible);
+    assert!(!camera_visible);
     assert!(panel.camera_visible);
     // `--camera` finds a USD camera by its prim path.
     let chosen = choose_camera(scene, Some("/World/Cam"), None, None).unwrap();

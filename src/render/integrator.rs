@@ -74,9 +74,31 @@ impl Renderer<'_> {
         let mut travelled = 0.0f32;
         let mut depth = 0;
         let mut pass_throughs = 0;
+        // Where the path last scattered (the camera at first): light densities are seen
+        // from there.
+        let mut vertex = ray.origin;
         loop {
             result.rays += 1;
-            let Some(hit) = self.accel.intersect(&ray) else {
+            let hit = self.accel.intersect(&ray);
+            if self.lights.has_spheres() {
+                // Sphere lamps the segment passes before its hit, which it goes on through.
+                let length = ray.direction.length();
+                let t_max = hit.map_or(f32::INFINITY, |h| h.t * length);
+                let (origin, d) = (ray.origin, ray.direction / length);
+                self.lights.spheres_along(
+                    vertex,
+                    origin,
+                    d,
+                    t_max,
+                    depth == 0,
+                    |l, light_pdf, t| {
+                        let weight = emission_weight(arrival, strategy, light_pdf);
+                        let through = medium.map_or(Vec3::ONE, |sigma| (-sigma * t).exp());
+                        result.radiance += weight * beta * through * l;
+                    },
+                );
+            }
+            let Some(hit) = hit else {
                 // The path leaves the scene: the environment, weighed like any emitter,
                 // unless it is hidden from camera rays.
                 let (environment, light_pdf) = self.lights.environment(ray.direction);
@@ -84,13 +106,7 @@ impl Renderer<'_> {
                     break;
                 }
                 if environment != Vec3::ZERO {
-                    let weight = match (arrival, strategy) {
-                        (Arrival::Specular, _) | (_, Strategy::BsdfOnly) => 1.0,
-                        (Arrival::Scattered { .. }, Strategy::LightOnly) => 0.0,
-                        (Arrival::Scattered { pdf }, Strategy::Mis) => {
-                            power_heuristic(pdf, light_pdf)
-                        }
-                    };
+                    let weight = emission_weight(arrival, strategy, light_pdf);
                     result.radiance += weight * beta * environment;
                 }
                 break;
@@ -125,15 +141,10 @@ impl Renderer<'_> {
 
             // Emission reached by the previous bounce.
             if material.is_emissive() && (front || material.double_sided) {
-                let weight = match (arrival, strategy) {
-                    (Arrival::Specular, _) | (_, Strategy::BsdfOnly) => 1.0,
-                    (Arrival::Scattered { .. }, Strategy::LightOnly) => 0.0,
-                    (Arrival::Scattered { pdf }, Strategy::Mis) => power_heuristic(
-                        pdf,
-                        self.lights
-                            .pdf(hit.instance, hit.triangle, travelled, cos_o),
-                    ),
-                };
+                let light_pdf = self
+                    .lights
+                    .pdf(hit.instance, hit.triangle, travelled, cos_o);
+                let weight = emission_weight(arrival, strategy, light_pdf);
                 result.radiance += weight * beta * shading.emission;
             }
             if depth == max_depth || (!front && !material.double_sided) {
@@ -189,6 +200,7 @@ impl Renderer<'_> {
                 offset_ray_origin(s.point, s.point_error, ng, sample.wi),
                 sample.wi,
             );
+            vertex = s.point;
             travelled = 0.0;
             depth += 1;
             pass_throughs = 0;
@@ -213,6 +225,9 @@ impl Renderer<'_> {
     }
 
     /// One light-sampling estimate of reflected direct light, MIS-weighted when asked.
+    ///
+    /// Delta lights are sampled even by the BSDF-only estimator, since nothing else finds
+    /// them; it samples nothing else.
     #[allow(clippy::too_many_arguments)]
     fn direct_light(
         &self,
@@ -282,5 +297,16 @@ impl Renderer<'_> {
             ray.t_min = hit.t;
         }
         true
+    }
+}
+
+/// The weight of emission found by a ray that arrived as `arrival`, from a light that
+/// light sampling would have drawn with solid-angle density `light_pdf`: full after the
+/// camera or a delta lobe, and otherwise as the strategy says (the power heuristic for MIS).
+fn emission_weight(arrival: Arrival, strategy: Strategy, light_pdf: f32) -> f32 {
+    match (arrival, strategy) {
+        (Arrival::Specular, _) | (_, Strategy::BsdfOnly) => 1.0,
+        (Arrival::Scattered { .. }, Strategy::LightOnly) => 0.0,
+        (Arrival::Scattered { pdf }, Strategy::Mis) => power_heuristic(pdf, light_pdf),
     }
 }

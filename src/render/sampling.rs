@@ -92,6 +92,18 @@ pub fn uniform_sphere(u: Vec2) -> Vec3 {
     Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
+/// A direction uniform over the cone of directions within θmax of +Z, given
+/// 1 − cos θmax (passed that way so that narrow cones keep their precision); density
+/// 1/(2π(1 − cos θmax)) (pbrt-v4 §A.5.4).
+pub fn uniform_cone(u: Vec2, one_minus_cos_max: f32) -> Vec3 {
+    let one_minus_cos = u.x * one_minus_cos_max;
+    let cos_theta = 1.0 - one_minus_cos;
+    // sin² = (1 − cos)(1 + cos), without the cancellation of 1 − cos².
+    let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * u.y;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
 /// Barycentrics (b1, b2) of a uniform point on a triangle (pbrt-v3 §13.6.5).
 pub fn uniform_triangle(u: Vec2) -> Vec2 {
     let s = u.x.sqrt();
@@ -308,6 +320,34 @@ mod tests {
             counts[ti * n_phi + pi] += 1.0;
         }
         // With pdf cos θ/π, cos²θ is uniform on [0, 1] and φ is uniform: all bins are equal.
+        let expected = samples as f64 / counts.len() as f64;
+        let chi2: f64 = counts
+            .iter()
+            .map(|c| (c - expected).powi(2) / expected)
+            .sum();
+        // 199 degrees of freedom: the 99.9th percentile is about 268.
+        assert!(chi2 < 268.0, "chi2 = {chi2}");
+    }
+
+    /// χ² test of cone sampling: with a uniform density over the cone, cos θ is uniform on
+    /// [cos θmax, 1] and φ on [0, 2π), so equal bins of (cos θ, φ) are equally likely.
+    #[test]
+    fn uniform_cone_matches_its_pdf_chi_square() {
+        let (n_theta, n_phi, samples) = (10usize, 20usize, 200_000usize);
+        let cos_max = 0.8f32;
+        let mut counts = vec![0f64; n_theta * n_phi];
+        let mut r = Rng::new(19, 4);
+        for _ in 0..samples {
+            let d = uniform_cone(r.uniform2(), 1.0 - cos_max);
+            assert!(
+                (d.length() - 1.0).abs() < 1e-5 && d.z >= cos_max - 1e-6,
+                "{d}"
+            );
+            let t = ((d.z - cos_max) / (1.0 - cos_max) * n_theta as f32) as usize;
+            let phi = d.y.atan2(d.x).rem_euclid(std::f32::consts::TAU);
+            let p = (phi / std::f32::consts::TAU * n_phi as f32) as usize;
+            counts[t.min(n_theta - 1) * n_phi + p.min(n_phi - 1)] += 1.0;
+        }
         let expected = samples as f64 / counts.len() as f64;
         let chi2: f64 = counts
             .iter()

@@ -1,5 +1,7 @@
-//! Lights without area (glTF `KHR_lights_punctual`): they are reached only by sampling them,
-//! never by a ray, so the integrator handles them apart from emissive surfaces.
+//! Lights that are not surfaces of the scene's meshes: glTF's `KHR_lights_punctual` (points,
+//! spots, suns: reached only by sampling them, never by a ray) and lamps with a size that
+//! are not geometry (a sphere: rays see its radiance and go on through it, and it casts no
+//! shadow, as lamps in Cycles).
 
 use std::f32::consts::PI;
 
@@ -32,6 +34,22 @@ pub enum LightKind {
         cos_outer: f32,
         /// Distance beyond which the light has no effect; `None`: unlimited.
         range: Option<f32>,
+    },
+    /// A sphere of uniform radiance: a lamp with a radius (Blender's point and spot lamps,
+    /// USD's `SphereLight`), optionally restricted to a spot cone: each point of the sphere
+    /// sends light in direction ω scaled by [`LightKind::Spot`]'s falloff of ω, as Cycles'
+    /// spot lamps with a radius do.
+    Sphere {
+        /// Centre.
+        position: Vec3,
+        /// Radius (> 0).
+        radius: f32,
+        /// Radiance leaving every point of the surface (W·sr⁻¹·m⁻²).
+        radiance: Vec3,
+        /// The spot cone: unit axis, cosine of the inner and of the outer angle.
+        spot: Option<(Vec3, f32, f32)>,
+        /// When false, camera rays pass it unseen (Blender's lamps, UsdLux lights).
+        camera_visible: bool,
     },
     /// Parallel light from infinitely far away, like the sun.
     Directional {
@@ -74,7 +92,25 @@ impl LightKind {
                     * spot_falloff(direction.dot(wo), cos_inner, cos_outer)
                     * range_window(distance, range)
             }
+            LightKind::Sphere {
+                radius, radiance, ..
+            } => {
+                // Seen from far away, a sphere is a disc of area πr².
+                radiance * PI * radius * radius * self.spot_factor(wo)
+            }
             LightKind::Directional { .. } => Vec3::ZERO,
+        }
+    }
+
+    /// A sphere's spot-cone falloff for light leaving it in unit direction `wo`; 1 for a
+    /// sphere without a cone and for every other kind.
+    pub fn spot_factor(&self, wo: Vec3) -> f32 {
+        match *self {
+            LightKind::Sphere {
+                spot: Some((direction, cos_inner, cos_outer)),
+                ..
+            } => spot_falloff(direction.dot(wo), cos_inner, cos_outer),
+            _ => 1.0,
         }
     }
 }
@@ -92,6 +128,18 @@ impl LightKind {
                 cos_outer,
                 ..
             } => 2.0 * PI * (1.0 - 0.5 * (cos_inner + cos_outer)) * mean(intensity),
+            LightKind::Sphere {
+                radius,
+                radiance,
+                spot,
+                ..
+            } => {
+                // π·L per unit area over 4πr²; a cone keeps its share of the directions.
+                let share = spot.map_or(1.0, |(_, cos_inner, cos_outer)| {
+                    0.5 * (1.0 - 0.5 * (cos_inner + cos_outer))
+                });
+                4.0 * PI * PI * radius * radius * mean(radiance) * share
+            }
             LightKind::Directional { irradiance, .. } => {
                 PI * scene_radius * scene_radius * mean(irradiance)
             }

@@ -17,8 +17,9 @@ unbiased settings, but keeps the world.
 - lighting_sun_sky: the same objects under a sun lamp (angle 0) and a constant sky-coloured
   world. `.glb` with the sun as KHR_lights_punctual (gridtrace adds the sky with
   `--environment R,G,B`) and `.usdc` (DistantLight + DomeLight).
-- lighting_lamps: a square area lamp and a point lamp of radius 0.25 m (Soft Falloff off:
-  a true sphere), both in view (Cycles does not show lamps to the camera), black world. `.usdc` only: the glTF exporter drops area
+- lighting_lamps: a square area lamp, a point lamp of radius 0.25 m and a spot lamp of
+  radius 0.15 m (Soft Falloff off: true spheres), in view (Cycles does not show lamps to the
+  camera), black world. `.usdc` only: the glTF exporter drops area
   lamps and point radii.
 """
 
@@ -28,6 +29,7 @@ import os
 import sys
 
 import bpy
+from mathutils import Vector
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from make_cornell import export, quad, reset, sphere  # noqa: E402
@@ -145,6 +147,20 @@ def build_lamps(scene):
     bulb = bpy.data.objects.new("Point", point)
     bulb.location = (1.4, -0.6, 1.7)
     scene.collection.objects.link(bulb)
+    # A spot lamp with a radius, its cone edge hard (blend 0): Cycles' smoothstep blend and
+    # glTF's/USD's squared-linear one agree only there.
+    spot = bpy.data.lights.new("Spot", "SPOT")
+    spot.energy = 300.0
+    spot.shadow_soft_size = 0.15
+    spot.use_soft_falloff = False
+    spot.spot_size = math.radians(50.0)
+    spot.spot_blend = 0.0
+    cone = bpy.data.objects.new("Spot", spot)
+    cone.location = (2.5, 1.0, 3.0)
+    # Pointing down at the floor left of the spheres (a spot shines along its local -Z).
+    direction = Vector((-3.5, -1.5, -3.0))
+    cone.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+    scene.collection.objects.link(cone)
 
 
 # name -> (builder, total reference samples, formats exported)

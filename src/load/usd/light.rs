@@ -150,9 +150,10 @@ impl UsdLoader {
         });
     }
 
-    /// UsdLux lights. Area lights and spheres are emitting surfaces that camera rays do not
-    /// see unless the file asks (see [`UsdLoader::camera_visibility`]). Radiance (area
-    /// lights) or radiant intensity (points) is
+    /// UsdLux lights. Rect and disk lights are emitting surfaces, a sphere with a radius a
+    /// sphere lamp; camera rays see none of them unless the file asks (see
+    /// [`UsdLoader::camera_visibility`]). Radiance (area lights) or radiant intensity
+    /// (points) is
     /// `intensity × 2^exposure × color`; `normalize` divides by the light's area, so that
     /// the power (π × radiance × area) stays `π × intensity` whatever its size — which is
     /// how Blender writes watts (intensity = W/π).
@@ -235,53 +236,61 @@ impl UsdLoader {
             "SphereLight" => {
                 let local_radius = self.get_f32(prim, "inputs:radius").unwrap_or(0.5);
                 let r = local_radius * area_scale.sqrt();
-                let shaped = self
-                    .get_f32(prim, "inputs:shaping:cone:angle")
-                    .is_some_and(|a| a < 180.0);
                 let as_point =
                     self.get(prim, "treatAsPoint").as_ref().and_then(as_bool) == Some(true);
-                if !as_point && !shaped && r > 0.0 {
-                    // A real sphere: an emitter of radiance L over its surface (one-sided,
-                    // outwards), as Cycles renders a point light with a radius.
-                    let (positions, indices) = uv_sphere(local_radius);
-                    let area = 4.0 * std::f32::consts::PI * local_radius * local_radius;
-                    emitter(self, positions, indices, area);
-                    return;
-                }
-                // A sphere of radiance L emits π·L·4πr² in all, i.e. L·πr² per steradian;
-                // normalized, L = intensity / 4πr², so intensity / 4 per steradian.
-                let per_steradian = if normalize || r == 0.0 {
-                    strength / 4.0
-                } else {
-                    strength * std::f32::consts::PI * r * r
-                };
-                if shaped && !as_point && r > 0.0 {
-                    self.warn(format!(
-                        "{where_}: shaped SphereLight of radius {r} is rendered as a point spot light"
-                    ));
-                }
                 let position = transform.transform_point3(Vec3::ZERO);
-                let kind = match self.get_f32(prim, "inputs:shaping:cone:angle") {
+                // The ShapingAPI cone, as glTF's inner and outer angles.
+                let cone = match self.get_f32(prim, "inputs:shaping:cone:angle") {
                     Some(angle) if angle < 180.0 => {
                         let softness = self
                             .get_f32(prim, "inputs:shaping:cone:softness")
                             .unwrap_or(0.0)
                             .clamp(0.0, 1.0);
                         let outer = angle.to_radians().min(std::f32::consts::FRAC_PI_2);
-                        LightKind::Spot {
-                            position,
-                            direction: transform.transform_vector3(Vec3::NEG_Z).normalize_or_zero(),
-                            intensity: per_steradian,
-                            cos_inner: (outer * (1.0 - softness)).cos(),
-                            cos_outer: outer.cos(),
-                            range: None,
-                        }
+                        let direction =
+                            transform.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+                        Some((direction, (outer * (1.0 - softness)).cos(), outer.cos()))
                     }
-                    _ => LightKind::Point {
+                    _ => None,
+                };
+                let kind = if !as_point && r > 0.0 {
+                    // A real sphere of radiance L, as Cycles renders a lamp with a radius;
+                    // normalized, L = intensity / 4πr².
+                    let radiance = if normalize {
+                        strength / (4.0 * std::f32::consts::PI * r * r)
+                    } else {
+                        strength
+                    };
+                    LightKind::Sphere {
                         position,
-                        intensity: per_steradian,
-                        range: None,
-                    },
+                        radius: r,
+                        radiance,
+                        spot: cone,
+                        camera_visible,
+                    }
+                } else {
+                    // A point: a sphere of radiance L sends L·πr² per steradian; normalized,
+                    // intensity / 4.
+                    let intensity = if normalize || r == 0.0 {
+                        strength / 4.0
+                    } else {
+                        strength * std::f32::consts::PI * r * r
+                    };
+                    match cone {
+                        Some((direction, cos_inner, cos_outer)) => LightKind::Spot {
+                            position,
+                            direction,
+                            intensity,
+                            cos_inner,
+                            cos_outer,
+                            range: None,
+                        },
+                        None => LightKind::Point {
+                            position,
+                            intensity,
+                            range: None,
+                        },
+                    }
                 };
                 self.builder.add_light(Light {
                     name: where_.clone(),
@@ -310,41 +319,6 @@ impl UsdLoader {
             _ => {}
         }
     }
-}
-
-/// A UV sphere of `radius` about the origin, wound outwards.
-fn uv_sphere(radius: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let (rings, segments) = (16u32, 32u32);
-    let mut positions = Vec::new();
-    for ring in 0..=rings {
-        let theta = std::f32::consts::PI * ring as f32 / rings as f32;
-        for segment in 0..=segments {
-            let phi = std::f32::consts::TAU * segment as f32 / segments as f32;
-            positions.push(
-                radius
-                    * Vec3::new(
-                        theta.sin() * phi.cos(),
-                        theta.sin() * phi.sin(),
-                        theta.cos(),
-                    ),
-            );
-        }
-    }
-    let row = segments + 1;
-    let mut indices = Vec::new();
-    for ring in 0..rings {
-        for segment in 0..segments {
-            let (a, b) = (ring * row + segment, (ring + 1) * row + segment);
-            // At the poles one of the two triangles has no area: leave it out.
-            if ring + 1 < rings {
-                indices.push([a, b, b + 1]);
-            }
-            if ring > 0 {
-                indices.push([a, b + 1, a + 1]);
-            }
-        }
-    }
-    (positions, indices)
 }
 
 /// The colour of a blackbody at `kelvin` (clamped to 1667–25000 K) relative to one at
@@ -383,19 +357,6 @@ fn blackbody_tint(kelvin: f32) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    pub(super) fn sphere_lights_are_wound_outwards() {
-        let (positions, indices) = uv_sphere(2.0);
-        // Each non-degenerate triangle's normal points away from the centre.
-        for t in &indices {
-            let [a, b, c] = t.map(|i| positions[i as usize]);
-            let n = (b - a).cross(c - a);
-            if n.length() > 1e-6 {
-                assert!(n.dot(a + b + c) > 0.0, "{t:?}");
-            }
-        }
-    }
 
     #[test]
     pub(super) fn colour_temperature_is_warm_below_and_cool_above_6500_kelvin() {

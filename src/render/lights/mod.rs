@@ -4,6 +4,7 @@
 //! beside its data, and nowhere else).
 
 mod environment;
+mod sphere;
 
 use std::collections::HashMap;
 
@@ -78,8 +79,11 @@ pub struct LightSet {
     distribution: Distribution1d,
     /// Index of the environment in `lights`, if it sends light.
     environment_index: Option<usize>,
-    /// Over the punctual lights alone, for estimators that find area lights by hitting them.
+    /// Over the delta lights alone (spheres weigh nothing), for estimators that find the
+    /// others by hitting them.
     punctual_distribution: Distribution1d,
+    /// Indices into `punctual` of the sphere lights, which bounce rays must look for.
+    spheres: Vec<usize>,
     /// Radius of a sphere around the scene's geometry: directional lights and the
     /// environment are sampled from beyond it, and their power is what crosses its disc.
     scene_radius: f32,
@@ -165,6 +169,7 @@ impl LightSet {
             distribution: Distribution1d::new(Vec::new()),
             environment_index,
             punctual_distribution: Distribution1d::new(Vec::new()),
+            spheres: Vec::new(),
             scene_radius,
             scene_center,
             first_of_instance,
@@ -183,8 +188,18 @@ impl LightSet {
             .map(|&light| set.power(light, &mut texture_mean))
             .collect();
         set.distribution = Distribution1d::new(weights);
-        set.punctual_distribution =
-            Distribution1d::new(set.punctual.iter().map(|l| l.power(scene_radius)).collect());
+        set.punctual_distribution = Distribution1d::new(
+            set.punctual
+                .iter()
+                .map(|l| match l {
+                    LightKind::Sphere { .. } => 0.0,
+                    _ => l.power(scene_radius),
+                })
+                .collect(),
+        );
+        set.spheres = (0..set.punctual.len())
+            .filter(|&i| matches!(set.punctual[i], LightKind::Sphere { .. }))
+            .collect();
         set
     }
 
@@ -236,7 +251,7 @@ impl LightSet {
         let (index, pmf) = self.distribution.sample(u_light)?;
         match self.lights[index] {
             Light::Triangle(i) => self.sample_triangle(scene, i, pmf, p, u),
-            Light::Punctual(i) => self.sample_punctual_light(i, pmf, p),
+            Light::Punctual(i) => self.sample_punctual_light(i, pmf, p, u),
             Light::Environment => self.sample_environment(pmf, p, u),
         }
     }
@@ -325,16 +340,41 @@ impl LightSet {
         }
     }
 
-    /// Draws a punctual light alone, by power, for shading point `p`.
+    /// Draws a delta light alone, by power, for shading point `p`.
     pub fn sample_punctual(&self, p: Vec3, u_light: f32) -> Option<LightSample> {
         let (index, pmf) = self.punctual_distribution.sample(u_light)?;
-        self.sample_punctual_light(index, pmf, p)
+        self.sample_punctual_light(index, pmf, p, Vec2::ZERO)
     }
 
-    /// The contribution of punctual light `index`, picked with probability `pmf`, at `p`.
-    fn sample_punctual_light(&self, index: usize, pmf: f32, p: Vec3) -> Option<LightSample> {
+    /// The contribution of scene light `index`, picked with probability `pmf`, at `p`.
+    fn sample_punctual_light(
+        &self,
+        index: usize,
+        pmf: f32,
+        p: Vec3,
+        u: Vec2,
+    ) -> Option<LightSample> {
         let light = &self.punctual[index];
         let (point, radiance) = match *light {
+            LightKind::Sphere {
+                position,
+                radius,
+                radiance,
+                ..
+            } => {
+                let s = sphere::sample(position, radius, p, u)?;
+                let spot = light.spot_factor(-s.wi);
+                return Some(LightSample {
+                    point: s.point,
+                    point_error: Vec3::splat(1e-6 * (radius + position.abs().max_element())),
+                    normal: s.normal,
+                    wi: s.wi,
+                    distance: s.distance,
+                    radiance: radiance * spot,
+                    pdf: pmf * s.pdf,
+                    is_delta: false,
+                });
+            }
             LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
                 let distance = position.distance(p);
                 if distance == 0.0 {
@@ -364,6 +404,48 @@ impl LightSet {
             pdf: pmf,
             is_delta: true,
         })
+    }
+
+    /// Calls `found` with the radiance, the light-sampling density (solid angle, seen from
+    /// `vertex`) and the distance of every sphere light that a ray from `origin` along unit
+    /// direction `d` passes before `t_max`. Spheres are not geometry: the ray goes on
+    /// through them. `camera` asks for a camera ray, which sees only spheres visible to it.
+    pub fn spheres_along(
+        &self,
+        vertex: Vec3,
+        origin: Vec3,
+        d: Vec3,
+        t_max: f32,
+        camera: bool,
+        mut found: impl FnMut(Vec3, f32, f32),
+    ) {
+        for &i in &self.spheres {
+            let light = &self.punctual[i];
+            let LightKind::Sphere {
+                position,
+                radius,
+                radiance,
+                camera_visible,
+                ..
+            } = *light
+            else {
+                continue;
+            };
+            if camera && !camera_visible {
+                continue;
+            }
+            if let Some(t) = sphere::intersect(position, radius, origin, d, 0.0, t_max) {
+                let spot = light.spot_factor(-d);
+                let pmf = self.distribution.pmf(self.triangles.len() + i);
+                let pdf = pmf * sphere::pdf(position, radius, vertex);
+                found(radiance * spot, pdf, t);
+            }
+        }
+    }
+
+    /// True when bounce rays must look for sphere lights.
+    pub fn has_spheres(&self) -> bool {
+        !self.spheres.is_empty()
     }
 
     /// The solid-angle density with which [`LightSet::sample`] would pick the point of
