@@ -28,7 +28,8 @@ pub struct SpherePoint {
 fn one_minus_cos_max(center: Vec3, radius: f32, p: Vec3) -> Option<f32> {
     let d2 = center.distance_squared(p);
     let sin2 = radius * radius / d2;
-    if !(sin2 < 1.0) {
+    // Inside the sphere, or at a NaN distance: no cone.
+    if sin2.is_nan() || sin2 >= 1.0 {
         return None;
     }
     // 1 − √(1 − s) = s / (1 + √(1 − s)), exact for tiny spheres too.
