@@ -4,9 +4,9 @@ mod binary;
 mod common;
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-use binary::gridtrace;
+use binary::{gridtrace, stderr};
 
 fn asset(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -14,10 +14,6 @@ fn asset(name: &str) -> String {
         .join(name)
         .display()
         .to_string()
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 #[test]

@@ -6,9 +6,8 @@
 mod binary;
 
 use std::path::{Path, PathBuf};
-use std::process::Output;
 
-use binary::gridtrace;
+use binary::{gridtrace, stderr};
 
 fn scene(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -16,10 +15,6 @@ fn scene(name: &str) -> String {
         .join(name)
         .display()
         .to_string()
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 /// Renders `file` at 24×24, 8 spp into `output` with `extra` options; returns stderr and

@@ -12,7 +12,6 @@ camera. Run with a Python that has `trimesh`, `pygltflib` and `usd-core` (PyPI):
 """
 
 import base64
-import struct
 import sys
 from pathlib import Path
 

@@ -10,16 +10,7 @@ use crate::scene::{EnvironmentMap, Texture, srgb_to_linear};
 /// without alpha are opaque; float images are clamped to [0, 1]. The decoder refuses
 /// images whose pixels would not fit in the memory budget, before allocating them.
 pub fn decode_texture(name: String, bytes: &[u8]) -> Result<Texture, String> {
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| format!("cannot be decoded ({e})"))?;
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(memory_budget());
-    reader.limits(limits);
-    let decoded = reader
-        .decode()
-        .map_err(|e| format!("cannot be decoded ({e})"))?;
-    let rgba = decoded.to_rgba16();
+    let rgba = decode(bytes)?.to_rgba16();
     let (width, height) = rgba.dimensions();
     Ok(Texture {
         name,
@@ -33,15 +24,7 @@ pub fn decode_texture(name: String, bytes: &[u8]) -> Result<Texture, String> {
 /// format [`decode_texture`] reads, taken as sRGB) as linear RGB radiance named `name`.
 /// Negative values (from image processing) become zero; a NaN or infinite value is an error.
 pub fn decode_environment(name: String, bytes: &[u8]) -> Result<EnvironmentMap, String> {
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| format!("cannot be decoded ({e})"))?;
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(memory_budget());
-    reader.limits(limits);
-    let decoded = reader
-        .decode()
-        .map_err(|e| format!("cannot be decoded ({e})"))?;
+    let decoded = decode(bytes)?;
     // Float images hold linear radiance; 8- and 16-bit ones are sRGB-encoded pictures.
     let linear = matches!(
         decoded.color(),
@@ -68,4 +51,18 @@ pub fn decode_environment(name: String, bytes: &[u8]) -> Result<EnvironmentMap, 
         height,
         texels,
     })
+}
+
+/// Decodes `bytes`, the format guessed from their first bytes, refusing images whose pixels
+/// would not fit in the memory budget before allocating them.
+fn decode(bytes: &[u8]) -> Result<image::DynamicImage, String> {
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot be decoded ({e})"))?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(memory_budget());
+    reader.limits(limits);
+    reader
+        .decode()
+        .map_err(|e| format!("cannot be decoded ({e})"))
 }

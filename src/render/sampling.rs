@@ -305,6 +305,18 @@ mod tests {
         }
     }
 
+    /// Pearson's χ² of 200 counts that should be equal, against the 99.9th percentile of
+    /// 199 degrees of freedom (about 268).
+    fn assert_equal_bins(counts: &[f64]) {
+        assert_eq!(counts.len(), 200);
+        let expected = counts.iter().sum::<f64>() / counts.len() as f64;
+        let chi2: f64 = counts
+            .iter()
+            .map(|c| (c - expected).powi(2) / expected)
+            .sum();
+        assert!(chi2 < 268.0, "chi2 = {chi2}");
+    }
+
     /// χ² test of cosine sampling against cos θ/π over a grid of (cos θ, φ) bins.
     #[test]
     fn cosine_hemisphere_matches_its_pdf_chi_square() {
@@ -320,13 +332,7 @@ mod tests {
             counts[ti * n_phi + pi] += 1.0;
         }
         // With pdf cos θ/π, cos²θ is uniform on [0, 1] and φ is uniform: all bins are equal.
-        let expected = samples as f64 / counts.len() as f64;
-        let chi2: f64 = counts
-            .iter()
-            .map(|c| (c - expected).powi(2) / expected)
-            .sum();
-        // 199 degrees of freedom: the 99.9th percentile is about 268.
-        assert!(chi2 < 268.0, "chi2 = {chi2}");
+        assert_equal_bins(&counts);
     }
 
     /// χ² test of cone sampling: with a uniform density over the cone, cos θ is uniform on
@@ -348,13 +354,7 @@ mod tests {
             let p = (phi / std::f32::consts::TAU * n_phi as f32) as usize;
             counts[t.min(n_theta - 1) * n_phi + p.min(n_phi - 1)] += 1.0;
         }
-        let expected = samples as f64 / counts.len() as f64;
-        let chi2: f64 = counts
-            .iter()
-            .map(|c| (c - expected).powi(2) / expected)
-            .sum();
-        // 199 degrees of freedom: the 99.9th percentile is about 268.
-        assert!(chi2 < 268.0, "chi2 = {chi2}");
+        assert_equal_bins(&counts);
     }
 
     #[test]

@@ -12,3 +12,8 @@ pub fn gridtrace(args: &[&str], cwd: &Path) -> Output {
         .output()
         .expect("run gridtrace")
 }
+
+/// What a run printed on stderr.
+pub fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}

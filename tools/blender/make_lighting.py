@@ -23,7 +23,6 @@ unbiased settings, but keeps the world.
   lamps and point radii.
 """
 
-import argparse
 import math
 import os
 import sys
@@ -34,7 +33,9 @@ from mathutils import Vector
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from make_cornell import export, quad, reset, sphere  # noqa: E402
 from make_principled import blender_default  # noqa: E402
-from make_references import REFERENCES, SCENES, add_camera, render  # noqa: E402
+from make_references import (  # noqa: E402
+    SCENES, add_camera, export_usd, render_reference, scene_arguments,
+)
 
 SKY_HDR = os.path.join(SCENES, "textures", "lighting_sky.hdr")
 SKY_COLOUR = (0.3, 0.45, 0.7)
@@ -172,13 +173,7 @@ SCENE_TABLE = {
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--samples", type=int, help="total Cycles samples per pixel per scene")
-    parser.add_argument("--only", action="append", help="scene name (repeatable)")
-    parser.add_argument("--export-only", action="store_true", help="rewrite the scene files, render nothing")
-    args = parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else None)
-    os.makedirs(SCENES, exist_ok=True)
-    os.makedirs(REFERENCES, exist_ok=True)
+    args = scene_arguments(__doc__.splitlines()[0])
     for name, (build, samples, formats) in SCENE_TABLE.items():
         if args.only and name not in args.only:
             continue
@@ -187,15 +182,9 @@ def main():
         if "glb" in formats:
             export(os.path.join(SCENES, f"{name}.glb"), lights=True)
         if "usdc" in formats:
-            path = os.path.join(SCENES, f"{name}.usdc")
-            bpy.ops.wm.usd_export(filepath=path, overwrite_textures=True)
-            print(f"wrote {path} ({os.path.getsize(path)} bytes)", flush=True)
-        if args.export_only:
-            continue
-        samples = args.samples or samples
-        for half, seed in (("a", 1), ("b", 2)):
-            render(scene, os.path.join(REFERENCES, f"{name}_{half}.exr"), samples // 2, seed,
-                   keep_world=True)
+            export_usd(os.path.join(SCENES, f"{name}.usdc"))
+        if not args.export_only:
+            render_reference(scene, name, args.samples or samples, keep_world=True)
     return 0
 
 

@@ -22,17 +22,15 @@ clamping, no denoising, 64 bounces, black world).
   its .usdc has an opaque ball and is not compared.
 """
 
-import argparse
 import math
 import os
 import sys
 
-import bpy
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import make_references  # noqa: E402  (shares Cycles settings and helpers)
 from make_cornell import export, principled, quad, reset, sphere  # noqa: E402
-from make_references import REFERENCES, SCENES, add_camera, make_image, render  # noqa: E402
+from make_references import (  # noqa: E402
+    SCENES, add_camera, export_usd, make_image, render_reference, scene_arguments,
+)
 
 
 def blender_default(name, colour, **inputs):
@@ -147,28 +145,16 @@ SCENE_TABLE = {
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--samples", type=int, help="total Cycles samples per pixel per scene")
-    parser.add_argument("--only", action="append", help="scene name (repeatable)")
-    parser.add_argument("--export-only", action="store_true", help="rewrite the scene files, render nothing")
-    args = parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else None)
-    os.makedirs(SCENES, exist_ok=True)
-    os.makedirs(REFERENCES, exist_ok=True)
+    args = scene_arguments(__doc__.splitlines()[0])
     for name, (build, samples) in SCENE_TABLE.items():
         if args.only and name not in args.only:
             continue
         scene = reset()
         build(scene)
         export(os.path.join(SCENES, f"{name}.glb"))
-        path = os.path.join(SCENES, f"{name}.usdc")
-        # Textures are written beside the layer; replace any left by an earlier run.
-        bpy.ops.wm.usd_export(filepath=path, overwrite_textures=True)
-        print(f"wrote {path} ({os.path.getsize(path)} bytes)", flush=True)
-        if args.export_only:
-            continue
-        samples = args.samples or samples
-        for half, seed in (("a", 1), ("b", 2)):
-            render(scene, os.path.join(REFERENCES, f"{name}_{half}.exr"), samples // 2, seed)
+        export_usd(os.path.join(SCENES, f"{name}.usdc"))
+        if not args.export_only:
+            render_reference(scene, name, args.samples or samples)
     return 0
 
 

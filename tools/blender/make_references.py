@@ -379,6 +379,36 @@ def _enum_items(node, prop):
     return {item.identifier for item in node.bl_rna.properties[prop].enum_items}
 
 
+def scene_arguments(description):
+    """The options the reference scripts share: --samples, --only, --export-only (after a
+    `--` when run through Blender's own command line)."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--samples", type=int, help="total Cycles samples per pixel per scene")
+    parser.add_argument("--only", action="append", help="scene name (repeatable)")
+    parser.add_argument("--export-only", action="store_true", help="rewrite the scene files, render nothing")
+    args = parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else None)
+    os.makedirs(SCENES, exist_ok=True)
+    os.makedirs(REFERENCES, exist_ok=True)
+    return args
+
+
+def export_usd(path):
+    """Blender's USD export of the scene; textures are written beside the layer, replacing
+    any left by an earlier run. An existing .usdc is removed first: USD saves over a crate
+    file by appending to it, so a re-exported file would keep growing."""
+    if os.path.exists(path):
+        os.remove(path)
+    bpy.ops.wm.usd_export(filepath=path, overwrite_textures=True)
+    print(f"wrote {path} ({os.path.getsize(path)} bytes)", flush=True)
+
+
+def render_reference(scene, name, samples, keep_world=False):
+    """The reference of `name`: two Cycles renders of half the samples, seeds 1 and 2."""
+    for half, seed in (("a", 1), ("b", 2)):
+        render(scene, os.path.join(REFERENCES, f"{name}_{half}.exr"), samples // 2, seed,
+               keep_world)
+
+
 def configure_cycles(scene, samples, seed, keep_world=False):
     scene.render.engine = "CYCLES"
     scene.render.resolution_x = SIZE
