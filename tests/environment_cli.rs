@@ -17,8 +17,8 @@ fn scene(name: &str) -> String {
         .to_string()
 }
 
-/// Renders `file` at 24×24, 8 spp into `output` with `extra` options; returns stderr and
-/// the RGBA pixels.
+/// Renders `file` at 24×24, 8 spp (unless `extra` names samples) into `output` with
+/// `extra` options; returns stderr and the RGBA pixels.
 fn render(dir: &Path, file: &str, output: &str, extra: &[&str]) -> (String, Vec<[f32; 4]>) {
     let path = scene(file);
     let mut args = vec![
@@ -30,7 +30,9 @@ fn render(dir: &Path, file: &str, output: &str, extra: &[&str]) -> (String, Vec<
         "--height",
         "24",
     ];
-    args.extend_from_slice(&["--spp", "8"]);
+    if !extra.contains(&"--samples") {
+        args.extend_from_slice(&["--spp", "8"]);
+    }
     args.extend_from_slice(extra);
     let out = gridtrace(&args, dir);
     assert!(out.status.success(), "{file} {extra:?}: {}", stderr(&out));
@@ -195,4 +197,27 @@ fn bad_environment_options_are_refused_in_one_line() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
     assert!(!dir.path().join("x.png").exists());
+}
+
+/// The environment is part of what a render is: parts rendered under different ones are
+/// not merged into one image.
+#[test]
+fn parts_under_different_environments_do_not_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = "third_party/trimesh_shapes.glb";
+    render(dir.path(), model, "a.exr", &["--samples", "0..4"]);
+    render(
+        dir.path(),
+        model,
+        "b.exr",
+        &["--samples", "4..8", "--environment-strength", "2"],
+    );
+    let out = gridtrace(&["merge", "a.exr", "b.exr", "-o", "m.exr"], dir.path());
+    let err = stderr(&out);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("not parts of one render") && err.contains("strength=2"),
+        "{err}"
+    );
+    assert!(!dir.path().join("m.exr").exists());
 }
