@@ -240,6 +240,10 @@ fn help_explains_every_option() {
         "--threads",
         "--camera",
         "--quiet",
+        "--environment",
+        "--environment-strength",
+        "--environment-rotation",
+        "--hide-environment",
     ] {
         assert!(help.contains(option), "--help lacks {option}:\n{help}");
     }
