@@ -212,7 +212,8 @@ fn the_command_line_splits_and_merges() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let scene = cornell_box().display().to_string();
-    let common = ["--width", "24", "-q"];
+    // With Cycles' Blackman–Harris filter: each sample still lands in one pixel.
+    let common = ["--width", "24", "-q", "--filter", "blackman-harris"];
     let run = |extra: &[&str]| {
         let args: Vec<&str> = [scene.as_str()]
             .into_iter()
@@ -273,6 +274,28 @@ fn the_command_line_splits_and_merges() {
         message.contains("seed10.exr") && message.contains("seed"),
         "{message}"
     );
+    assert!(!d.join("bad.exr").exists());
+    // So is another pixel filter.
+    let out = gridtrace(
+        &[
+            &scene,
+            "--width",
+            "24",
+            "-q",
+            "--seed",
+            "9",
+            "--samples",
+            "12..16",
+            "-o",
+            "box.exr",
+        ],
+        d,
+    );
+    assert!(out.status.success());
+    let out = gridtrace(&["merge", "merged.exr", "box.exr", "-o", "bad.exr"], d);
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{message}");
+    assert!(message.contains("filter=box"), "{message}");
     assert!(!d.join("bad.exr").exists());
 
     // --spp and --samples are two ways of saying how many samples: not both.

@@ -9,6 +9,7 @@ use super::environment::{EnvironmentChoice, parse_degrees, parse_environment, pa
 use crate::limits::parse_size;
 use crate::load::GltfLightUnits;
 use crate::record::parse_range;
+use crate::render::FilterKind;
 
 /// Render a glTF 2.0 (.gltf, .glb), USD (.usd, .usda, .usdc, .usdz) or PLY scene with a
 /// physically based path tracer.
@@ -142,6 +143,15 @@ pub struct Args {
     #[arg(long)]
     pub hide_environment: bool,
 
+    /// Pixel filter, sampled by filter importance sampling (each sample lands in one pixel,
+    /// weight 1, so parts still merge exactly). Cycles' default is blackman-harris 1.5.
+    #[arg(long, value_enum, value_name = "FILTER", default_value = "box")]
+    pub filter: FilterKind,
+
+    /// Width of the pixel filter in pixels. [default: 1 for box, 1.5 for the others]
+    #[arg(long, value_name = "PIXELS", value_parser = parse_filter_width)]
+    pub filter_width: Option<f32>,
+
     /// Every SECONDS, write the image so far to the output (atomically, as a part that
     /// `gridtrace merge` accepts), so a killed render keeps its samples.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
@@ -195,4 +205,12 @@ fn parse_seconds(text: &str) -> Result<f64, String> {
         .ok()
         .filter(|s| s.is_finite() && *s > 0.0)
         .ok_or_else(|| format!("'{text}' is not a positive number of seconds"))
+}
+
+/// A filter width: finite, from 1/64 to 16 pixels.
+fn parse_filter_width(text: &str) -> Result<f32, String> {
+    text.parse::<f32>()
+        .ok()
+        .filter(|w| w.is_finite() && (1.0 / 64.0..=16.0).contains(w))
+        .ok_or_else(|| format!("'{text}' is not a filter width from 1/64 to 16 pixels"))
 }

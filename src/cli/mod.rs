@@ -24,7 +24,9 @@ use crate::load::{LoadOptions, load_scene_with};
 use crate::merge::merge_files;
 use crate::output::{Format, check_writable, write_image_with_record};
 use crate::record::{RenderIdentity, RenderRecord, format_range, sha256_file, sha256_files};
-use crate::render::{Image, RenderSettings, RenderStats, Renderer, Strategy, film_bytes};
+use crate::render::{
+    FilterKind, Image, RenderSettings, RenderStats, Renderer, Strategy, film_bytes,
+};
 use crate::scene::{Camera, Scene};
 use environment::apply_environment;
 use signals::{Phase, output_lock, set_phase};
@@ -180,6 +182,11 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         max_depth: args.max_depth,
         seed: args.seed,
         strategy: Strategy::Mis,
+        filter: args.filter,
+        filter_width: args.filter_width.unwrap_or(match args.filter {
+            FilterKind::Box => 1.0,
+            _ => 1.5,
+        }),
     };
 
     let renderer = pool.install(|| Renderer::new(&scene));
@@ -209,7 +216,14 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         height,
         seed: settings.seed,
         max_depth: settings.max_depth,
-        load_options: format!("{} {environment_label}", load_options_label(&options)),
+        load_options: format!(
+            "{} {environment_label} filter={}:{}",
+            load_options_label(&options),
+            args.filter
+                .to_possible_value()
+                .map_or_else(String::new, |v| v.get_name().to_string()),
+            settings.filter_width
+        ),
     };
     let scene_name = scene_path
         .file_name()

@@ -6,6 +6,7 @@
 mod bsdf;
 mod camera;
 mod film;
+mod filter;
 mod integrator;
 mod lights;
 pub mod sampling;
@@ -15,6 +16,7 @@ mod surface;
 pub use bsdf::{Bsdf, BsdfSample, fresnel_dielectric};
 pub use camera::RayGenerator;
 pub use film::{Image, PixelAccumulator};
+pub use filter::{FilterKind, PixelFilter, profile as filter_profile};
 pub use integrator::{PathResult, Strategy};
 pub use lights::{LightSample, LightSet};
 pub use surface::{gamma, interpolate_with_error, offset_ray_origin, transform_point_with_error};
@@ -48,6 +50,10 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Direct-light estimator.
     pub strategy: Strategy,
+    /// Pixel reconstruction filter.
+    pub filter: FilterKind,
+    /// Its width in pixels.
+    pub filter_width: f32,
 }
 
 impl Default for RenderSettings {
@@ -60,6 +66,8 @@ impl Default for RenderSettings {
             max_depth: 16,
             seed: 0,
             strategy: Strategy::Mis,
+            filter: FilterKind::Box,
+            filter_width: 1.0,
         }
     }
 }
@@ -166,6 +174,7 @@ impl<'a> Renderer<'a> {
     ) -> (Image, RenderStats) {
         let start = Instant::now();
         let generator = RayGenerator::new(camera, settings.width, settings.height);
+        let filter = PixelFilter::new(settings.filter, settings.filter_width);
         let width = settings.width as usize;
         let spp = settings.spp.max(1).min(u32::MAX - settings.first_sample);
         let seed = mix64(settings.seed);
@@ -181,8 +190,8 @@ impl<'a> Renderer<'a> {
                     for (x, acc) in row.iter_mut().enumerate() {
                         let pixel = (y * width + x) as u64;
                         let mut rng = Rng::for_sample(seed, pixel, sample);
-                        let jitter = rng.uniform2();
-                        let ray = generator.generate(x as f32 + jitter.x, y as f32 + jitter.y);
+                        let at = filter.sample(rng.uniform2());
+                        let ray = generator.generate(x as f32 + at.x, y as f32 + at.y);
                         let path =
                             self.trace_path(ray, &mut rng, settings.max_depth, settings.strategy);
                         rays += path.rays;
