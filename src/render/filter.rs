@@ -17,10 +17,10 @@ pub enum FilterKind {
     /// Uniform over a square `width` pixels wide (1: the pixel itself).
     #[default]
     Box,
-    /// exp(−2·(3x/width)²), truncated at ±width/2 (Cycles' Gaussian: σ = width/6).
+    /// A Gaussian of σ = width/4, truncated at ±1.5·width (Cycles' definition).
     Gaussian,
-    /// The 4-term Blackman–Harris window over ±width/2 (Harris 1978, Cycles' default at
-    /// 1.5 pixels).
+    /// The 4-term Blackman–Harris window (Harris 1978) spanning ±width pixels: Cycles'
+    /// definition, whose default "1.5 px" spans three pixels.
     BlackmanHarris,
 }
 
@@ -32,6 +32,8 @@ const STEPS: usize = 4096;
 pub struct PixelFilter {
     kind: FilterKind,
     width: f32,
+    /// The footprint's full width in pixels.
+    support: f32,
     /// The CDF over [−½, ½] (in units of the width) at `STEPS` + 1 evenly spaced points,
     /// from 0 to 1; empty for a box.
     cdf: Vec<f32>,
@@ -49,7 +51,12 @@ impl PixelFilter {
             FilterKind::Box => Vec::new(),
             _ => tabulated_cdf(|t| profile(kind, t)),
         };
-        PixelFilter { kind, width, cdf }
+        PixelFilter {
+            kind,
+            width,
+            support: width * support_per_width(kind),
+            cdf,
+        }
     }
 
     /// The default: a one-pixel box.
@@ -75,13 +82,13 @@ impl PixelFilter {
             FilterKind::Box if self.width == 1.0 => u,
             FilterKind::Box => Vec2::splat(0.5) + (u - 0.5) * self.width,
             _ => Vec2::new(
-                0.5 + self.width * self.lookup(u.x),
-                0.5 + self.width * self.lookup(u.y),
+                0.5 + self.support * self.lookup(u.x),
+                0.5 + self.support * self.lookup(u.y),
             ),
         }
     }
 
-    /// The offset (in units of the width) where the CDF reaches `u`: the step it falls in,
+    /// The offset (in units of the support) where the CDF reaches `u`: the step it falls in,
     /// and the place within the step where the CDF, linear over it, reaches `u`.
     fn lookup(&self, u: f32) -> f32 {
         let j = self.cdf.partition_point(|&c| c <= u).clamp(1, STEPS);
@@ -91,11 +98,22 @@ impl PixelFilter {
     }
 }
 
-/// The 1D filter's shape at `t` in [−½, ½] (in units of the width), not normalised.
+/// The footprint's full width over the filter's nominal width (Cycles' film.cpp: Gaussian
+/// ×3, Blackman–Harris ×2).
+pub fn support_per_width(kind: FilterKind) -> f32 {
+    match kind {
+        FilterKind::Box => 1.0,
+        FilterKind::Gaussian => 3.0,
+        FilterKind::BlackmanHarris => 2.0,
+    }
+}
+
+/// The 1D filter's shape at `t` in [−½, ½] (in units of its support), not normalised.
 pub fn profile(kind: FilterKind, t: f32) -> f32 {
     match kind {
         FilterKind::Box => 1.0,
-        FilterKind::Gaussian => (-2.0 * (3.0 * t) * (3.0 * t)).exp(),
+        // exp(−x²/2σ²) with x = 3·width·t and σ = width/4.
+        FilterKind::Gaussian => (-72.0 * t * t).exp(),
         FilterKind::BlackmanHarris => {
             let x = std::f32::consts::TAU * (t + 0.5);
             0.35875 - 0.48829 * x.cos() + 0.14128 * (2.0 * x).cos() - 0.01168 * (3.0 * x).cos()
@@ -131,12 +149,13 @@ mod tests {
         ] {
             let width = 1.5;
             let filter = PixelFilter::new(kind, width);
+            let support = width * support_per_width(kind);
             let (bins, samples) = (40usize, 400_000usize);
             let mut counts = vec![0f64; bins];
             let mut r = Rng::new(29, kind as u64);
             for _ in 0..samples {
                 let p = filter.sample(r.uniform2());
-                let t = (p.x - 0.5) / width + 0.5;
+                let t = (p.x - 0.5) / support + 0.5;
                 assert!((0.0..=1.0).contains(&t), "{kind:?}: {p}");
                 counts[((t * bins as f32) as usize).min(bins - 1)] += 1.0;
             }

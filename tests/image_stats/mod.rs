@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use gridtrace::load::load_scene;
 use gridtrace::output::write_image;
-use gridtrace::render::{Image, RenderSettings, Renderer};
+use gridtrace::render::{FilterKind, Image, RenderSettings, Renderer};
 
 /// Width and height of the references.
 pub const SIZE: usize = 128;
@@ -125,12 +125,26 @@ pub fn render(
     spp: u32,
     seed: u64,
 ) -> Vec<DVec3> {
+    render_filtered(renderer, camera, spp, seed, FilterKind::Box, 1.0)
+}
+
+/// [`render`] through pixel filter `filter` of `width` pixels.
+pub fn render_filtered(
+    renderer: &Renderer,
+    camera: &gridtrace::scene::Camera,
+    spp: u32,
+    seed: u64,
+    filter: FilterKind,
+    filter_width: f32,
+) -> Vec<DVec3> {
     let settings = RenderSettings {
         width: SIZE as u32,
         height: SIZE as u32,
         spp,
         max_depth: MAX_DEPTH,
         seed,
+        filter,
+        filter_width,
         ..RenderSettings::default()
     };
     let (image, stats) = renderer.render(camera, &settings, &|| {});

@@ -402,14 +402,14 @@ def export_usd(path):
     print(f"wrote {path} ({os.path.getsize(path)} bytes)", flush=True)
 
 
-def render_reference(scene, name, samples, keep_world=False):
+def render_reference(scene, name, samples, keep_world=False, pixel_filter=("BOX", 1.0)):
     """The reference of `name`: two Cycles renders of half the samples, seeds 1 and 2."""
     for half, seed in (("a", 1), ("b", 2)):
         render(scene, os.path.join(REFERENCES, f"{name}_{half}.exr"), samples // 2, seed,
-               keep_world)
+               keep_world, pixel_filter)
 
 
-def configure_cycles(scene, samples, seed, keep_world=False):
+def configure_cycles(scene, samples, seed, keep_world=False, pixel_filter=("BOX", 1.0)):
     scene.render.engine = "CYCLES"
     scene.render.resolution_x = SIZE
     scene.render.resolution_y = SIZE
@@ -430,8 +430,7 @@ def configure_cycles(scene, samples, seed, keep_world=False):
     c.use_denoising = False
     c.seed = seed
     c.use_animated_seed = False
-    c.pixel_filter_type = "BOX"
-    c.filter_width = 1.0
+    c.pixel_filter_type, c.filter_width = pixel_filter
     c.sample_clamp_direct = 0.0
     c.sample_clamp_indirect = 0.0
     c.blur_glossy = 0.0
@@ -456,8 +455,8 @@ def configure_cycles(scene, samples, seed, keep_world=False):
             obj.cycles.shadow_terminator_offset = 0.0
 
 
-def render(scene, path, samples, seed, keep_world=False):
-    configure_cycles(scene, samples, seed, keep_world)
+def render(scene, path, samples, seed, keep_world=False, pixel_filter=("BOX", 1.0)):
+    configure_cycles(scene, samples, seed, keep_world, pixel_filter)
     scene.render.filepath = path
     start = time.time()
     bpy.ops.render.render(write_still=True)
