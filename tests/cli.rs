@@ -244,6 +244,9 @@ fn help_explains_every_option() {
         "--environment-strength",
         "--environment-rotation",
         "--hide-environment",
+        "--fstop",
+        "--focus-distance",
+        "--filter",
     ] {
         assert!(help.contains(option), "--help lacks {option}:\n{help}");
     }

@@ -212,8 +212,17 @@ fn the_command_line_splits_and_merges() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let scene = cornell_box().display().to_string();
-    // With Cycles' Blackman–Harris filter: each sample still lands in one pixel.
-    let common = ["--width", "24", "-q", "--filter", "blackman-harris"];
+    // With Cycles' Blackman–Harris filter (each sample still lands in one pixel) and depth
+    // of field (a lens position per sample).
+    let common = [
+        "--width",
+        "24",
+        "-q",
+        "--filter",
+        "blackman-harris",
+        "--fstop",
+        "0.7",
+    ];
     let run = |extra: &[&str]| {
         let args: Vec<&str> = [scene.as_str()]
             .into_iter()
@@ -275,7 +284,7 @@ fn the_command_line_splits_and_merges() {
         "{message}"
     );
     assert!(!d.join("bad.exr").exists());
-    // So is another pixel filter.
+    // So is another pixel filter (the same lens).
     let out = gridtrace(
         &[
             &scene,
@@ -286,6 +295,8 @@ fn the_command_line_splits_and_merges() {
             "9",
             "--samples",
             "12..16",
+            "--fstop",
+            "0.7",
             "-o",
             "box.exr",
         ],

@@ -143,6 +143,17 @@ pub struct Args {
     #[arg(long)]
     pub hide_environment: bool,
 
+    /// Depth of field: the lens's f-number (aperture diameter = focal length / N); 0 turns
+    /// off the depth of field a USD camera has. The focal length is the camera's (USD) or,
+    /// for cameras without one, that of a 24 mm-high sensor at its field of view, in metres.
+    #[arg(long, value_name = "N", value_parser = parse_fstop)]
+    pub fstop: Option<f32>,
+
+    /// Distance to the plane in focus, in scene units. [default: the camera's, or the
+    /// distance to the centre of the scene]
+    #[arg(long, value_name = "DISTANCE", value_parser = parse_distance)]
+    pub focus_distance: Option<f32>,
+
     /// Pixel filter, sampled by filter importance sampling (each sample lands in one pixel,
     /// weight 1, so parts still merge exactly). Cycles' default is blackman-harris 1.5.
     #[arg(long, value_enum, value_name = "FILTER", default_value = "box")]
@@ -213,4 +224,20 @@ fn parse_filter_width(text: &str) -> Result<f32, String> {
         .ok()
         .filter(|w| w.is_finite() && (1.0 / 64.0..=16.0).contains(w))
         .ok_or_else(|| format!("'{text}' is not a filter width from 1/64 to 16 pixels"))
+}
+
+/// An f-number: finite and not negative (0: no depth of field).
+fn parse_fstop(text: &str) -> Result<f32, String> {
+    text.parse::<f32>()
+        .ok()
+        .filter(|n| n.is_finite() && *n >= 0.0)
+        .ok_or_else(|| format!("'{text}' is not an f-number (0 or more)"))
+}
+
+/// A positive, finite distance.
+fn parse_distance(text: &str) -> Result<f32, String> {
+    text.parse::<f32>()
+        .ok()
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .ok_or_else(|| format!("'{text}' is not a positive distance"))
 }

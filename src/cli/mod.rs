@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, ValueEnum};
+use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::inspect::describe;
@@ -27,7 +28,7 @@ use crate::record::{RenderIdentity, RenderRecord, format_range, sha256_file, sha
 use crate::render::{
     FilterKind, Image, RenderSettings, RenderStats, Renderer, Strategy, film_bytes,
 };
-use crate::scene::{Camera, Scene};
+use crate::scene::{Camera, Projection, Scene, ThinLens};
 use environment::apply_environment;
 use signals::{Phase, output_lock, set_phase};
 
@@ -148,6 +149,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     }
 
     let camera = choose_camera(&scene, args.camera.as_deref(), args.width, args.height)?;
+    let camera = with_depth_of_field(camera, args.fstop, args.focus_distance, &scene);
     camera.validate().map_err(|why| {
         anyhow!(
             "{}: camera {}: {why}",
@@ -336,9 +338,58 @@ fn run_merge(args: &MergeArgs) -> Result<()> {
     Ok(())
 }
 
-/// How the record names a camera: its name and where it came from.
+/// How the record names a camera: its name and where it came from, and its lens.
 fn camera_label(camera: &Camera) -> String {
-    format!("'{}' ({})", camera.name, camera.source)
+    match camera.lens {
+        Some(l) => format!(
+            "'{}' ({}) lens radius {} focus {}",
+            camera.name, camera.source, l.radius, l.focus_distance
+        ),
+        None => format!("'{}' ({})", camera.name, camera.source),
+    }
+}
+
+/// `camera` with the depth of field `--fstop` and `--focus-distance` ask for: f-number 0
+/// removes it; the focal length is the camera's or, without one, that of a 24 mm-high
+/// (full-frame) sensor at its vertical field of view with scene units taken as metres; the
+/// focus distance is the option's, the camera's, or the distance to the scene's centre
+/// along the view.
+pub fn with_depth_of_field(
+    mut camera: Camera,
+    fstop: Option<f32>,
+    focus_distance: Option<f32>,
+    scene: &Scene,
+) -> Camera {
+    let Projection::Perspective { yfov, .. } = camera.projection else {
+        return camera;
+    };
+    let focus = focus_distance
+        .or(camera.lens.map(|l| l.focus_distance))
+        .unwrap_or_else(|| {
+            let forward = camera
+                .world_from_camera
+                .transform_vector3(Vec3::NEG_Z)
+                .normalize();
+            let eye = camera.world_from_camera.transform_point3(Vec3::ZERO);
+            (scene.bounds().center() - eye)
+                .dot(forward)
+                .max(camera.znear.max(1e-3))
+        });
+    let radius = match fstop {
+        Some(n) if n > 0.0 => {
+            let focal = camera
+                .focal_length
+                .unwrap_or_else(|| 0.012 / (0.5 * yfov).tan());
+            Some(focal / (2.0 * n))
+        }
+        Some(_) => None,
+        None => camera.lens.map(|l| l.radius),
+    };
+    camera.lens = radius.map(|radius| ThinLens {
+        radius,
+        focus_distance: focus,
+    });
+    camera
 }
 
 /// The loader options that change the scene, as the record stores them.

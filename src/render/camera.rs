@@ -2,8 +2,9 @@
 
 use glam::{Affine3A, Vec2, Vec3};
 
+use super::sampling::concentric_disk;
 use crate::accel::Ray;
-use crate::scene::{Camera, Projection};
+use crate::scene::{Camera, Projection, ThinLens};
 
 /// Generates the ray through a point of the image plane.
 #[derive(Clone, Debug)]
@@ -14,6 +15,7 @@ pub struct RayGenerator {
     /// (orthographic), horizontally and vertically.
     half_extent: Vec2,
     znear: f32,
+    lens: Option<ThinLens>,
     width: u32,
     height: u32,
 }
@@ -35,6 +37,10 @@ impl RayGenerator {
             projection: camera.projection,
             half_extent,
             znear: camera.znear.max(0.0),
+            lens: match camera.projection {
+                Projection::Perspective { .. } => camera.lens.filter(|l| l.radius > 0.0),
+                Projection::Orthographic { .. } => None,
+            },
             width,
             height,
         }
@@ -45,14 +51,35 @@ impl RayGenerator {
     /// The direction is not normalised: its camera-space z is −1, so `t_min = znear` clips
     /// exactly at the near plane.
     pub fn generate(&self, x: f32, y: f32) -> Ray {
+        self.generate_through_lens(x, y, Vec2::splat(0.5))
+    }
+
+    /// True when rays leave a lens of some size: each sample then needs a lens position.
+    pub fn has_lens(&self) -> bool {
+        self.lens.is_some()
+    }
+
+    /// [`RayGenerator::generate`] from the point of the lens that uniforms `u` pick (the
+    /// concentric map onto the aperture disc); the centre, (½, ½), is the pinhole's ray.
+    /// The direction keeps camera-space z = −1.
+    pub fn generate_through_lens(&self, x: f32, y: f32, u: Vec2) -> Ray {
         let ndc = Vec2::new(
             2.0 * x / self.width as f32 - 1.0,
             1.0 - 2.0 * y / self.height as f32,
         );
         let plane = ndc * self.half_extent;
-        let (origin, direction) = match self.projection {
-            Projection::Perspective { .. } => (Vec3::ZERO, Vec3::new(plane.x, plane.y, -1.0)),
-            Projection::Orthographic { .. } => (Vec3::new(plane.x, plane.y, 0.0), Vec3::NEG_Z),
+        let (origin, direction) = match (self.projection, self.lens) {
+            (Projection::Perspective { .. }, Some(lens)) => {
+                // Through the lens point towards where the pinhole ray meets the focus plane.
+                let at = lens.radius * concentric_disk(u);
+                let focus = lens.focus_distance * Vec3::new(plane.x, plane.y, -1.0);
+                let origin = Vec3::new(at.x, at.y, 0.0);
+                (origin, (focus - origin) / lens.focus_distance)
+            }
+            (Projection::Perspective { .. }, None) => {
+                (Vec3::ZERO, Vec3::new(plane.x, plane.y, -1.0))
+            }
+            (Projection::Orthographic { .. }, _) => (Vec3::new(plane.x, plane.y, 0.0), Vec3::NEG_Z),
         };
         Ray {
             origin: self.world_from_camera.transform_point3(origin),
@@ -77,6 +104,8 @@ mod tests {
                 aspect_ratio: None,
             },
             znear: 0.1,
+            lens: None,
+            focal_length: None,
             source: String::new(),
         };
         let g = RayGenerator::new(&cam, 200, 100);

@@ -191,7 +191,15 @@ impl<'a> Renderer<'a> {
                         let pixel = (y * width + x) as u64;
                         let mut rng = Rng::for_sample(seed, pixel, sample);
                         let at = filter.sample(rng.uniform2());
-                        let ray = generator.generate(x as f32 + at.x, y as f32 + at.y);
+                        // A lens position only when there is a lens, so pinhole images keep
+                        // their random streams.
+                        let lens = if generator.has_lens() {
+                            rng.uniform2()
+                        } else {
+                            glam::Vec2::splat(0.5)
+                        };
+                        let (px, py) = (x as f32 + at.x, y as f32 + at.y);
+                        let ray = generator.generate_through_lens(px, py, lens);
                         let path =
                             self.trace_path(ray, &mut rng, settings.max_depth, settings.strategy);
                         rays += path.rays;

@@ -21,6 +21,17 @@ pub enum Projection {
     },
 }
 
+/// A thin lens (Kolb et al. 1995; pbrt-v4 §5.2.3): rays leave a disc of `radius` and meet
+/// where the pinhole ray meets the plane `focus_distance` in front of the camera, so what
+/// lies on that plane is sharp and the rest is blurred by its circle of confusion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    /// Radius of the aperture in scene units (focal length / (2 × f-number)).
+    pub radius: f32,
+    /// Distance from the camera to the plane in focus, in scene units.
+    pub focus_distance: f32,
+}
+
 /// A camera placed in the world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
@@ -32,6 +43,10 @@ pub struct Camera {
     pub projection: Projection,
     /// Distance to the near clipping plane: nothing closer is seen.
     pub znear: f32,
+    /// Depth of field, if the camera has it (perspective cameras only).
+    pub lens: Option<ThinLens>,
+    /// Focal length in scene units where the file says it (USD), for `--fstop`.
+    pub focal_length: Option<f32>,
     /// Where the camera came from, for messages.
     pub source: String,
 }
@@ -128,6 +143,8 @@ impl Camera {
                 aspect_ratio: Some(aspect),
             },
             znear: 1e-3 * distance,
+            lens: None,
+            focal_length: None,
             source: "default camera framing the scene".into(),
         }
     }

@@ -13,7 +13,7 @@ mod mesh;
 mod texture;
 
 pub use builder::SceneBuilder;
-pub use camera::{Camera, Projection};
+pub use camera::{Camera, Projection, ThinLens};
 pub use environment::{Environment, EnvironmentMap, blender_world_rotation, map_direction, map_uv};
 pub use light::{Light, LightKind};
 pub use material::{AlphaMode, ChannelRef, Material, MaterialTextures, Pbr, f0_of_ior};

@@ -123,6 +123,8 @@ pub fn camera_at(z: f32, yfov_degrees: f32) -> Camera {
             aspect_ratio: None,
         },
         znear: 0.0,
+        lens: None,
+        focal_length: None,
         source: "test".into(),
     }
 }

@@ -403,6 +403,8 @@ impl GltfLoader {
             ),
             projection,
             znear,
+            lens: None,
+            focal_length: None,
             source: source.to_string(),
         });
     }

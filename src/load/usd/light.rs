@@ -4,7 +4,7 @@ use glam::{Affine3A, Mat3, Mat4, Vec3};
 use openusd::sdf;
 
 use super::{DISK_SEGMENTS, UsdLoader, as_asset, as_bool, as_vec3};
-use crate::scene::{Camera, Environment, Light, LightKind, Material, Projection};
+use crate::scene::{Camera, Environment, Light, LightKind, Material, Projection, ThinLens};
 
 impl UsdLoader {
     /// A UsdLux light's `intensity × 2^exposure × color`, tinted by its colour temperature
@@ -138,6 +138,18 @@ impl UsdLoader {
                 aspect_ratio: Some(horizontal / vertical),
             }
         };
+        // Depth of field: a thin lens of radius focal length / (2 × fStop), focused at
+        // focusDistance (scene units); fStop 0, USD's default, is a pinhole.
+        let focal_length = 0.1 * focal * scale.y;
+        let f_stop = self.get_f32(prim, "fStop").unwrap_or(0.0);
+        let focus = self.get_f32(prim, "focusDistance").unwrap_or(0.0) * scale.y;
+        let lens =
+            (f_stop > 0.0 && focus > 0.0 && f_stop.is_finite() && focus.is_finite()).then(|| {
+                ThinLens {
+                    radius: focal_length / (2.0 * f_stop),
+                    focus_distance: focus,
+                }
+            });
         self.builder.add_camera(Camera {
             name: where_.clone(),
             world_from_camera: Affine3A::from_rotation_translation(
@@ -146,6 +158,8 @@ impl UsdLoader {
             ),
             projection,
             znear: znear * scale.y,
+            lens,
+            focal_length: (focal_length > 0.0).then_some(focal_length),
             source: where_,
         });
     }
