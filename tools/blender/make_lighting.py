@@ -17,6 +17,8 @@ unbiased settings, but keeps the world.
 - lighting_sun_sky: the same objects under a sun lamp (angle 0) and a constant sky-coloured
   world. `.glb` with the sun as KHR_lights_punctual (gridtrace adds the sky with
   `--environment R,G,B`) and `.usdc` (DistantLight + DomeLight).
+- lighting_dof: lighting_sun_sky through a lens (f/0.4, focused on the grey sphere):
+  Blender's camera depth of field as its USD exporter writes it. `.usdc` only.
 - lighting_lamps: a square area lamp, a point lamp of radius 0.25 m and a spot lamp of
   radius 0.15 m (Soft Falloff off: true spheres), in view (Cycles does not show lamps to the
   camera), black world. `.usdc` only: the glTF exporter drops area
@@ -164,11 +166,23 @@ def build_lamps(scene):
     scene.collection.objects.link(cone)
 
 
+def build_dof(scene):
+    """The sun-and-sky scene through a lens: focused on the grey sphere, f/0.4, so the
+    floor and the other spheres blur (depth of field is a camera setting Blender's USD
+    exporter writes as fStop and focusDistance)."""
+    build_sun_sky(scene)
+    camera = scene.camera
+    camera.data.dof.use_dof = True
+    camera.data.dof.aperture_fstop = 0.4
+    camera.data.dof.focus_distance = (Vector((-1.1, 0.0, 0.5)) - camera.location).length
+
+
 # name -> (builder, total reference samples, formats exported)
 SCENE_TABLE = {
     "lighting_hdr": (build_hdr, 2048, ("glb", "usdc")),
     "lighting_sun_sky": (build_sun_sky, 2048, ("glb", "usdc")),
     "lighting_lamps": (build_lamps, 2048, ("usdc",)),
+    "lighting_dof": (build_dof, 2048, ("usdc",)),
 }
 
 
