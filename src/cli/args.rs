@@ -202,42 +202,56 @@ pub struct MergeArgs {
     pub max_memory: Option<u64>,
 }
 
+/// `text` as a number that `accepts`, or an error saying it is not `what`.
+pub fn parse_number<T: std::str::FromStr + Copy>(
+    text: &str,
+    accepts: impl Fn(T) -> bool,
+    what: &str,
+) -> Result<T, String> {
+    text.parse::<T>()
+        .ok()
+        .filter(|v| accepts(*v))
+        .ok_or_else(|| format!("'{text}' is not {what}"))
+}
+
 /// A finite frame number (USD time code).
 pub fn parse_frame(text: &str) -> Result<f64, String> {
-    text.parse::<f64>()
-        .ok()
-        .filter(|f| f.is_finite())
-        .ok_or_else(|| format!("'{text}' is not a frame number"))
+    parse_number(text, f64::is_finite, "a frame number")
 }
 
 /// A positive, finite number of seconds.
 fn parse_seconds(text: &str) -> Result<f64, String> {
-    text.parse::<f64>()
-        .ok()
-        .filter(|s| s.is_finite() && *s > 0.0)
-        .ok_or_else(|| format!("'{text}' is not a positive number of seconds"))
+    parse_number(
+        text,
+        |s: f64| s.is_finite() && s > 0.0,
+        "a positive number of seconds",
+    )
 }
 
-/// A filter width: finite, from 1/64 to 16 pixels.
+/// A filter width: from 1/64 to 16 pixels.
 fn parse_filter_width(text: &str) -> Result<f32, String> {
-    text.parse::<f32>()
-        .ok()
-        .filter(|w| w.is_finite() && (1.0 / 64.0..=16.0).contains(w))
-        .ok_or_else(|| format!("'{text}' is not a filter width from 1/64 to 16 pixels"))
+    let range = 1.0 / 64.0..=16.0;
+    parse_number(
+        text,
+        |w| range.contains(&w),
+        "a filter width from 1/64 to 16 pixels",
+    )
 }
 
 /// An f-number: finite and not negative (0: no depth of field).
 fn parse_fstop(text: &str) -> Result<f32, String> {
-    text.parse::<f32>()
-        .ok()
-        .filter(|n| n.is_finite() && *n >= 0.0)
-        .ok_or_else(|| format!("'{text}' is not an f-number (0 or more)"))
+    parse_number(
+        text,
+        |n: f32| n.is_finite() && n >= 0.0,
+        "an f-number (0 or more)",
+    )
 }
 
 /// A positive, finite distance.
 fn parse_distance(text: &str) -> Result<f32, String> {
-    text.parse::<f32>()
-        .ok()
-        .filter(|d| d.is_finite() && *d > 0.0)
-        .ok_or_else(|| format!("'{text}' is not a positive distance"))
+    parse_number(
+        text,
+        |d: f32| d.is_finite() && d > 0.0,
+        "a positive distance",
+    )
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use glam::{Mat3, Vec3};
 
-use super::args::Args;
+use super::args::{Args, parse_number};
 use crate::load::load_environment;
 use crate::record::sha256_file;
 use crate::scene::{Environment, Scene};
@@ -49,18 +49,13 @@ fn colour(c: Vec3, text: &str) -> Result<EnvironmentChoice, String> {
 
 /// A finite, non-negative strength.
 pub fn parse_strength(text: &str) -> Result<f32, String> {
-    text.parse::<f32>()
-        .ok()
-        .filter(|s| s.is_finite() && *s >= 0.0)
-        .ok_or_else(|| format!("'{text}' is not a finite, non-negative number"))
+    let ok = |s: f32| s.is_finite() && s >= 0.0;
+    parse_number(text, ok, "a finite, non-negative number")
 }
 
 /// A finite angle in degrees.
 pub fn parse_degrees(text: &str) -> Result<f32, String> {
-    text.parse::<f32>()
-        .ok()
-        .filter(|s| s.is_finite())
-        .ok_or_else(|| format!("'{text}' is not a finite number of degrees"))
+    parse_number(text, f32::is_finite, "a finite number of degrees")
 }
 
 /// Sets the scene's environment as the options say. Returns the note to print when the
