@@ -55,7 +55,8 @@ impl SceneFiles {
 }
 
 /// Every buffer's bytes, in buffer order: the GLB binary chunk, a base64 data URI, or a file
-/// read through the policy, each holding at least its `byteLength` (glTF 2.0 §3.6.1).
+/// read through the policy, each holding at least its `byteLength` (glTF 2.0 §3.6.1), with
+/// meshopt-compressed views decoded in place.
 pub(super) fn read_buffers(
     document: &gltf::Document,
     mut blob: Option<Vec<u8>>,
@@ -72,6 +73,10 @@ pub(super) fn read_buffers(
         check_memory(|| format!("buffer {index}"), length as u64)
             .map_err(|e| invalid(e.to_string()))?;
         let (mut data, name) = match buffer.source() {
+            // Filled by the compressed views decoded into it (EXT_meshopt_compression).
+            gltf::buffer::Source::Bin if super::meshopt::is_fallback(&buffer) => {
+                (vec![0; length], "its decoded views".to_string())
+            }
             gltf::buffer::Source::Bin => (
                 blob.take().ok_or_else(|| {
                     invalid(format!(
@@ -104,6 +109,7 @@ pub(super) fn read_buffers(
         }
         buffers.push(gltf::buffer::Data(data));
     }
+    super::meshopt::decode_views(document, &mut buffers).map_err(invalid)?;
     Ok(buffers)
 }
 

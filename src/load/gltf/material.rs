@@ -24,6 +24,7 @@ impl GltfLoader {
         );
         let info_ref = |loader: &mut GltfLoader, info: gltf::texture::Info| {
             loader.texture_ref(
+                document,
                 &info.texture(),
                 info.tex_coord(),
                 info.texture_transform(),
@@ -71,7 +72,8 @@ impl GltfLoader {
                     channel: 0,
                 }),
             normal: material.normal_texture().and_then(|info| {
-                let mut r = self.texture_ref(&info.texture(), info.tex_coord(), None, &name)?;
+                let mut r =
+                    self.texture_ref(document, &info.texture(), info.tex_coord(), None, &name)?;
                 // The gltf crate exposes KHR_texture_transform on normal textures only as JSON.
                 if let Some(t) = info.extension_value("KHR_texture_transform") {
                     json_texture_transform(t, &mut r);
@@ -174,7 +176,7 @@ impl GltfLoader {
             .as_u64()
             .unwrap_or(0)
             .min(u64::from(u32::MAX)) as u32;
-        let mut r = self.texture_ref(&texture, set, None, material)?;
+        let mut r = self.texture_ref(document, &texture, set, None, material)?;
         if let Some(t) = info["extensions"].get("KHR_texture_transform") {
             json_texture_transform(t, &mut r);
         }
@@ -202,12 +204,13 @@ impl GltfLoader {
     /// material then shows its constant factors, as if the texture were white (or flat).
     pub(super) fn texture_ref(
         &mut self,
+        document: &gltf::Document,
         texture: &gltf::Texture,
         tex_coord: u32,
         transform: Option<gltf::texture::TextureTransform>,
         material: &str,
     ) -> Option<TextureRef> {
-        let image = self.image_texture(&texture.source())?;
+        let image = self.image_texture(&texture_image(document, texture)?)?;
         let texcoord = transform
             .as_ref()
             .and_then(|t| t.tex_coord())
@@ -284,6 +287,26 @@ impl GltfLoader {
             }
         }
     }
+}
+
+/// Image extensions gridtrace decodes, in order of preference over `source` (each names an
+/// image in its `source`; `source` itself is then a fallback, or absent).
+const IMAGE_EXTENSIONS: [&str; 2] = ["KHR_texture_basisu", "EXT_texture_webp"];
+
+/// The image a texture shows: the first image extension's, else its own `source`.
+fn texture_image<'a>(
+    document: &'a gltf::Document,
+    texture: &gltf::Texture,
+) -> Option<gltf::Image<'a>> {
+    IMAGE_EXTENSIONS
+        .iter()
+        .filter_map(|name| texture.extension_value(name)?["source"].as_u64())
+        .find_map(|i| document.images().nth(i as usize))
+        .or_else(|| {
+            texture
+                .source()
+                .and_then(|s| document.images().nth(s.index()))
+        })
 }
 
 /// A number in extension JSON, or `default` when absent or not finite.

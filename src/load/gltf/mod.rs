@@ -5,18 +5,20 @@
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
-use glam::{Affine2, Affine3A, Mat4, Vec2, Vec3, Vec4};
+use glam::{Affine2, Affine3A, Mat4, Vec2, Vec3};
 use gltf::json::validation::Validate;
-use gltf::mesh::Mode;
 
+mod accessor;
+mod draco;
 mod files;
 mod material;
+mod meshopt;
+mod primitive;
 
 use files::{SceneFiles, read_buffers};
 
-use super::tangents::generate_tangents;
 use super::{AssetRoots, GltfLightUnits, LoadError, LoadOptions, Loaded};
-use crate::scene::{Camera, Light, LightKind, Material, Mesh, Projection, SceneBuilder};
+use crate::scene::{Camera, Light, LightKind, Material, Projection, SceneBuilder};
 
 /// Extensions whose meaning gridtrace implements.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
@@ -29,6 +31,10 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_specular",
     "KHR_materials_clearcoat",
     "KHR_materials_sheen",
+    "KHR_mesh_quantization",
+    "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
 ];
 
 /// Texture-coordinate sets read (`TEXCOORD_0` to `TEXCOORD_3`).
@@ -211,7 +217,13 @@ fn validate(document: &gltf::Document) -> Result<(), String> {
     }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
-        errors.push(format!("{}: {error}", path()))
+        let path = path().to_string();
+        // gltf-json requires a bufferView without `sparse`, but an accessor without one is
+        // all zeros, which an extension (Draco) may fill (glTF 2.0 §3.6.2.3).
+        let zeros = path.starts_with("accessors[") && path.ends_with("].bufferView");
+        if !(zeros && matches!(error, gltf::json::validation::Error::Missing)) {
+            errors.push(format!("{path}: {error}"));
+        }
     });
     match errors.len() {
         0 => Ok(()),
@@ -295,7 +307,7 @@ impl GltfLoader {
                 None => format!("node {}", node.index()),
             };
             if let Some(mesh) = node.mesh() {
-                for our_mesh in self.meshes_of(&mesh)? {
+                for our_mesh in self.meshes_of(document, &mesh)? {
                     self.builder
                         .add_instance(our_mesh, Affine3A::from_mat4(world), source.clone());
                 }
@@ -410,236 +422,21 @@ impl GltfLoader {
     }
 
     /// Our meshes for a glTF mesh, converting it the first time it is used.
-    fn meshes_of(&mut self, mesh: &gltf::Mesh) -> Result<Vec<usize>, LoadError> {
+    fn meshes_of(
+        &mut self,
+        document: &gltf::Document,
+        mesh: &gltf::Mesh,
+    ) -> Result<Vec<usize>, LoadError> {
         if let Some(ours) = self.meshes.get(&mesh.index()) {
             return Ok(ours.clone());
         }
         let mut ours = Vec::new();
         for primitive in mesh.primitives() {
-            if let Some(m) = self.convert_primitive(mesh, &primitive)? {
+            if let Some(m) = self.convert_primitive(document, mesh, &primitive)? {
                 ours.push(self.builder.add_full_mesh(m));
             }
         }
         self.meshes.insert(mesh.index(), ours.clone());
         Ok(ours)
-    }
-
-    fn convert_primitive(
-        &mut self,
-        mesh: &gltf::Mesh,
-        primitive: &gltf::Primitive,
-    ) -> Result<Option<Mesh>, LoadError> {
-        let name = format!(
-            "mesh {} '{}' primitive {}",
-            mesh.index(),
-            mesh.name().unwrap_or(""),
-            primitive.index()
-        );
-        if matches!(
-            primitive.mode(),
-            Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip
-        ) {
-            self.warn(format!(
-                "{name}: skipping {:?} primitive (only triangles are rendered)",
-                primitive.mode()
-            ));
-            return Ok(None);
-        }
-        for (_, accessor) in primitive.attributes() {
-            self.check_accessor(&accessor, &name)?;
-        }
-        if let Some(accessor) = primitive.indices() {
-            self.check_accessor(&accessor, &name)?;
-            // The gltf crate's index reader hits `unreachable!` on other types (found by fuzzing).
-            let integer = matches!(
-                accessor.data_type(),
-                gltf::accessor::DataType::U8
-                    | gltf::accessor::DataType::U16
-                    | gltf::accessor::DataType::U32
-            );
-            if !integer || accessor.dimensions() != gltf::accessor::Dimensions::Scalar {
-                return Err(self.invalid(format!(
-                    "{name}: index accessor {} is {:?} {:?}, not unsigned integer scalars",
-                    accessor.index(),
-                    accessor.dimensions(),
-                    accessor.data_type()
-                )));
-            }
-        }
-        let buffers = &self.buffers;
-        let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-        let Some(positions) = reader.read_positions() else {
-            return Err(self.invalid(format!("{name}: no POSITION attribute")));
-        };
-        let positions: Vec<Vec3> = positions.map(Vec3::from).collect();
-        let corners: Vec<u32> = match reader.read_indices() {
-            Some(indices) => indices.into_u32().collect(),
-            None => (0..positions.len() as u32).collect(),
-        };
-        if let Some(&bad) = corners.iter().find(|&&i| i as usize >= positions.len()) {
-            return Err(self.invalid(format!(
-                "{name}: index {bad} is past the {} vertices",
-                positions.len()
-            )));
-        }
-        let indices = triangles(primitive.mode(), &corners);
-        let leftover = if primitive.mode() == Mode::Triangles {
-            corners.len() % 3
-        } else {
-            0
-        };
-        let normals = match reader.read_normals() {
-            Some(n) => n
-                .map(|n| Vec3::from(n).try_normalize().unwrap_or(Vec3::ZERO))
-                .collect::<Vec<_>>(),
-            None => Vec::new(),
-        };
-        // Without (usable) normals, glTF asks for flat shading: empty means face normals.
-        let normals =
-            if normals.len() == positions.len() && normals.iter().all(|n| *n != Vec3::ZERO) {
-                normals
-            } else {
-                Vec::new()
-            };
-        let mut uvs = Vec::new();
-        while uvs.len() < MAX_UV_SETS {
-            let Some(set) = reader.read_tex_coords(uvs.len() as u32) else {
-                break;
-            };
-            let set: Vec<Vec2> = set.into_f32().map(Vec2::from).collect();
-            uvs.push(if set.len() == positions.len() {
-                set
-            } else {
-                Vec::new()
-            });
-        }
-        let colours: Vec<Vec4> = reader
-            .read_colors(0)
-            .map(|c| c.into_rgba_f32().map(Vec4::from).collect())
-            .filter(|c: &Vec<Vec4>| c.len() == positions.len())
-            .unwrap_or_default();
-        let tangents: Vec<Vec4> = reader
-            .read_tangents()
-            .map(|t| t.map(Vec4::from).collect())
-            .filter(|t: &Vec<Vec4>| t.len() == positions.len())
-            .unwrap_or_default();
-        if leftover != 0 {
-            self.warn(format!(
-                "{name}: {leftover} index(es) left over after the last whole triangle"
-            ));
-        }
-        // COLOR_0 multiplies the base colour of any material, the default one included
-        // (glTF 2.0 §3.7.2.1).
-        let material = self.material_for(primitive);
-        if !colours.is_empty() {
-            self.coloured_materials.insert(material);
-        }
-        let mut mesh = Mesh {
-            name,
-            positions,
-            normals,
-            uvs,
-            colours,
-            tangents,
-            indices,
-            material,
-        };
-        let normal_uvs = primitive
-            .material()
-            .index()
-            .and_then(|m| self.normal_mapped.get(m).copied().flatten());
-        if let Some(set) = normal_uvs
-            && mesh.tangents.is_empty()
-            && !generate_tangents(&mut mesh, set)
-        {
-            self.warn(format!(
-                "{}: a normal map needs TEXCOORD_{set}, which is missing; the normal map is ignored here",
-                mesh.name
-            ));
-        }
-        Ok(Some(mesh))
-    }
-
-    /// Rejects accessors whose data would run past their buffer view or buffer.
-    fn check_accessor(&self, accessor: &gltf::Accessor, name: &str) -> Result<(), LoadError> {
-        if accessor.sparse().is_some() {
-            return Err(self.invalid(format!(
-                "{name}: sparse accessor {} is not supported",
-                accessor.index()
-            )));
-        }
-        let Some(view) = accessor.view() else {
-            return Ok(());
-        };
-        let element = accessor.size();
-        let stride = view.stride().unwrap_or(element);
-        if stride < element {
-            return Err(self.invalid(format!(
-                "{name}: buffer view {} has byte stride {stride}, smaller than accessor {}'s {element}-byte elements (they would overlap)",
-                view.index(),
-                accessor.index()
-            )));
-        }
-        // In u128: counts and offsets come from the file and may be anything up to 2^64.
-        let needed = match accessor.count() as u128 {
-            0 => 0,
-            n => accessor.offset() as u128 + stride as u128 * (n - 1) + element as u128,
-        };
-        let buffer_len = self
-            .buffers
-            .get(view.buffer().index())
-            .map_or(0, |b| b.0.len());
-        let view_end = view.offset() as u128 + view.length() as u128;
-        if needed > view.length() as u128 || view_end > buffer_len as u128 {
-            return Err(self.invalid(format!(
-                "{name}: accessor {} needs {needed} bytes but buffer view {} holds {} (buffer {} has {buffer_len})",
-                accessor.index(),
-                view.index(),
-                view.length(),
-                view.buffer().index()
-            )));
-        }
-        Ok(())
-    }
-}
-
-/// Triangles from a list, strip or fan of corner indices (glTF 2.0 §3.7.2.1).
-fn triangles(mode: Mode, corners: &[u32]) -> Vec<[u32; 3]> {
-    match mode {
-        Mode::TriangleStrip => (0..corners.len().saturating_sub(2))
-            .map(|i| {
-                if i % 2 == 0 {
-                    [corners[i], corners[i + 1], corners[i + 2]]
-                } else {
-                    [corners[i], corners[i + 2], corners[i + 1]]
-                }
-            })
-            .collect(),
-        Mode::TriangleFan => (1..corners.len().saturating_sub(1))
-            .map(|i| [corners[i], corners[i + 1], corners[0]])
-            .collect(),
-        _ => corners
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect(),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn strips_and_fans_keep_winding() {
-        assert_eq!(
-            triangles(Mode::TriangleStrip, &[0, 1, 2, 3]),
-            vec![[0, 1, 2], [1, 3, 2]]
-        );
-        assert_eq!(
-            triangles(Mode::TriangleFan, &[0, 1, 2, 3]),
-            vec![[1, 2, 0], [2, 3, 0]]
-        );
-        assert_eq!(triangles(Mode::Triangles, &[0, 1, 2, 3]), vec![[0, 1, 2]]);
-        assert!(triangles(Mode::TriangleStrip, &[0, 1]).is_empty());
     }
 }

@@ -1,0 +1,242 @@
+//! A glTF mesh primitive as a scene mesh: its vertex attributes read from accessors (any
+//! storage, `KHR_mesh_quantization` included) or from a Draco stream, its triangles from a
+//! list, strip or fan.
+
+use glam::{Vec2, Vec3, Vec4};
+use gltf::mesh::Mode;
+
+use super::accessor::{Elements, read_floats, read_indices};
+use super::draco::{self, DracoGeometry};
+use super::{GltfLoader, MAX_UV_SETS};
+use crate::load::LoadError;
+use crate::load::tangents::generate_tangents;
+use crate::scene::Mesh;
+
+/// The attributes of one primitive, from wherever its file keeps them.
+pub(super) struct VertexSource<'a> {
+    primitive: &'a gltf::Primitive<'a>,
+    buffers: &'a [gltf::buffer::Data],
+    draco: Option<DracoGeometry>,
+}
+
+impl<'a> VertexSource<'a> {
+    pub fn new(
+        primitive: &'a gltf::Primitive<'a>,
+        document: &gltf::Document,
+        buffers: &'a [gltf::buffer::Data],
+    ) -> Result<VertexSource<'a>, String> {
+        let draco = draco::decode(primitive, document, buffers)?;
+        Ok(VertexSource {
+            primitive,
+            buffers,
+            draco,
+        })
+    }
+
+    /// The attribute named `semantic` (`"POSITION"`, `"TEXCOORD_1"`, ...), if present.
+    pub fn attribute(&mut self, semantic: &str) -> Result<Option<Elements>, String> {
+        if let Some(draco) = &mut self.draco
+            && let Some(elements) = draco.take(semantic)
+        {
+            return Ok(Some(elements));
+        }
+        match self
+            .primitive
+            .attributes()
+            .find(|(s, _)| s.to_string() == semantic)
+        {
+            Some((_, accessor)) => read_floats(&accessor, self.buffers)
+                .map(Some)
+                .map_err(|why| format!("{semantic}: {why}")),
+            None => Ok(None),
+        }
+    }
+
+    /// The corner indices, or `None` for non-indexed geometry.
+    pub fn indices(&mut self) -> Result<Option<Vec<u32>>, String> {
+        if let Some(draco) = &mut self.draco {
+            return Ok(Some(std::mem::take(&mut draco.indices)));
+        }
+        self.primitive
+            .indices()
+            .map(|accessor| read_indices(&accessor, self.buffers))
+            .transpose()
+    }
+}
+
+impl GltfLoader {
+    pub(super) fn convert_primitive(
+        &mut self,
+        document: &gltf::Document,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+    ) -> Result<Option<Mesh>, LoadError> {
+        let name = format!(
+            "mesh {} '{}' primitive {}",
+            mesh.index(),
+            mesh.name().unwrap_or(""),
+            primitive.index()
+        );
+        if matches!(
+            primitive.mode(),
+            Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip
+        ) {
+            self.warn(format!(
+                "{name}: skipping {:?} primitive (only triangles are rendered)",
+                primitive.mode()
+            ));
+            return Ok(None);
+        }
+        let invalid = |why: String| LoadError::Invalid {
+            path: self.path.clone(),
+            what: format!("{name}: {why}"),
+        };
+        let mut source = VertexSource::new(primitive, document, &self.buffers).map_err(invalid)?;
+        let Some(positions) = source.attribute("POSITION").map_err(invalid)? else {
+            return Err(invalid("no POSITION attribute".into()));
+        };
+        let positions: Vec<Vec3> = (0..positions.len())
+            .map(|i| Vec3::from(positions.get::<3>(i)))
+            .collect();
+        let corners: Vec<u32> = match source.indices().map_err(invalid)? {
+            Some(indices) => indices,
+            None => (0..positions.len() as u32).collect(),
+        };
+        if let Some(&bad) = corners.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(invalid(format!(
+                "index {bad} is past the {} vertices",
+                positions.len()
+            )));
+        }
+        let per_vertex = |e: Option<Elements>| e.filter(|e| e.len() == positions.len());
+        let normals: Vec<Vec3> = per_vertex(source.attribute("NORMAL").map_err(invalid)?)
+            .map(|n| {
+                (0..n.len())
+                    .map(|i| {
+                        Vec3::from(n.get::<3>(i))
+                            .try_normalize()
+                            .unwrap_or(Vec3::ZERO)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        // Without (usable) normals, glTF asks for flat shading: empty means face normals.
+        let normals = if normals.iter().all(|n| *n != Vec3::ZERO) {
+            normals
+        } else {
+            Vec::new()
+        };
+        let mut uvs = Vec::new();
+        while uvs.len() < MAX_UV_SETS {
+            let Some(set) = source
+                .attribute(&format!("TEXCOORD_{}", uvs.len()))
+                .map_err(invalid)?
+            else {
+                break;
+            };
+            uvs.push(if set.len() == positions.len() {
+                (0..set.len())
+                    .map(|i| Vec2::from(set.get::<2>(i)))
+                    .collect()
+            } else {
+                Vec::new()
+            });
+        }
+        let colours: Vec<Vec4> = per_vertex(source.attribute("COLOR_0").map_err(invalid)?)
+            .map(|c| {
+                let opaque = c.components < 4;
+                (0..c.len())
+                    .map(|i| {
+                        let v = Vec4::from(c.get::<4>(i));
+                        if opaque { v.with_w(1.0) } else { v }
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let tangents: Vec<Vec4> = per_vertex(source.attribute("TANGENT").map_err(invalid)?)
+            .map(|t| (0..t.len()).map(|i| Vec4::from(t.get::<4>(i))).collect())
+            .unwrap_or_default();
+        let indices = triangles(primitive.mode(), &corners);
+        let leftover = if primitive.mode() == Mode::Triangles {
+            corners.len() % 3
+        } else {
+            0
+        };
+        if leftover != 0 {
+            self.warn(format!(
+                "{name}: {leftover} index(es) left over after the last whole triangle"
+            ));
+        }
+        // COLOR_0 multiplies the base colour of any material, the default one included
+        // (glTF 2.0 §3.7.2.1).
+        let material = self.material_for(primitive);
+        if !colours.is_empty() {
+            self.coloured_materials.insert(material);
+        }
+        let mut mesh = Mesh {
+            name,
+            positions,
+            normals,
+            uvs,
+            colours,
+            tangents,
+            indices,
+            material,
+        };
+        let normal_uvs = primitive
+            .material()
+            .index()
+            .and_then(|m| self.normal_mapped.get(m).copied().flatten());
+        if let Some(set) = normal_uvs
+            && mesh.tangents.is_empty()
+            && !generate_tangents(&mut mesh, set)
+        {
+            self.warn(format!(
+                "{}: a normal map needs TEXCOORD_{set}, which is missing; the normal map is ignored here",
+                mesh.name
+            ));
+        }
+        Ok(Some(mesh))
+    }
+}
+
+/// Triangles from a list, strip or fan of corner indices (glTF 2.0 §3.7.2.1).
+fn triangles(mode: Mode, corners: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::TriangleStrip => (0..corners.len().saturating_sub(2))
+            .map(|i| {
+                if i % 2 == 0 {
+                    [corners[i], corners[i + 1], corners[i + 2]]
+                } else {
+                    [corners[i], corners[i + 2], corners[i + 1]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (1..corners.len().saturating_sub(1))
+            .map(|i| [corners[i], corners[i + 1], corners[0]])
+            .collect(),
+        _ => corners
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_keep_winding() {
+        assert_eq!(
+            triangles(Mode::TriangleStrip, &[0, 1, 2, 3]),
+            vec![[0, 1, 2], [1, 3, 2]]
+        );
+        assert_eq!(
+            triangles(Mode::TriangleFan, &[0, 1, 2, 3]),
+            vec![[1, 2, 0], [2, 3, 0]]
+        );
+        assert_eq!(triangles(Mode::Triangles, &[0, 1, 2, 3]), vec![[0, 1, 2]]);
+        assert!(triangles(Mode::TriangleStrip, &[0, 1]).is_empty());
+    }
+}
