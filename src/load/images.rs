@@ -1,8 +1,9 @@
-//! Encoded images decoded within the memory budget: PNG and JPEG (and float formats) into
-//! [`Texture`]s, every pixel format widened to 16-bit RGBA; Radiance HDR and OpenEXR
+//! Encoded images decoded within the memory budget: PNG, JPEG, WebP (and float formats),
+//! and Basis Universal KTX2 (`KHR_texture_basisu`) into [`Texture`]s, every pixel format
+//! widened to 16-bit RGBA; Radiance HDR and OpenEXR
 //! latitude–longitude maps into linear float [`EnvironmentMap`]s.
 
-use crate::limits::memory_budget;
+use crate::limits::{check_memory, memory_budget};
 use crate::scene::{EnvironmentMap, Texture, srgb_to_linear};
 
 /// The image in `bytes` (format guessed from its first bytes) as a texture named `name`.
@@ -10,6 +11,9 @@ use crate::scene::{EnvironmentMap, Texture, srgb_to_linear};
 /// without alpha are opaque; float images are clamped to [0, 1]. The decoder refuses
 /// images whose pixels would not fit in the memory budget, before allocating them.
 pub fn decode_texture(name: String, bytes: &[u8]) -> Result<Texture, String> {
+    if bytes.starts_with(KTX2_MAGIC) {
+        return decode_basis(name, bytes);
+    }
     let rgba = decode(bytes)?.to_rgba16();
     let (width, height) = rgba.dimensions();
     Ok(Texture {
@@ -17,6 +21,39 @@ pub fn decode_texture(name: String, bytes: &[u8]) -> Result<Texture, String> {
         width,
         height,
         texels: rgba.pixels().map(|p| p.0).collect(),
+    })
+}
+
+/// The first bytes of every KTX 2.0 file (KTX 2.0 §3.1).
+const KTX2_MAGIC: &[u8] = b"\xabKTX 20\xbb\r\n\x1a\n";
+
+/// A Basis Universal KTX2 texture (ETC1S or UASTC, any supercompression): its first
+/// level transcoded to 8-bit RGBA by `basisu`, a pure-Rust port of Binomial's reference
+/// transcoder. The values stay as encoded (sRGB or linear), like a PNG's.
+fn decode_basis(name: String, bytes: &[u8]) -> Result<Texture, String> {
+    use basisu::{DecodeFlags, TargetFormat, Transcoder};
+    let failed = |e: basisu::Error| format!("cannot be decoded as KTX2 ({e:?})");
+    let transcoder = Transcoder::new(bytes).map_err(failed)?;
+    let (width, height) = transcoder.base_dimensions();
+    let texels = u64::from(width) * u64::from(height);
+    // The 8-bit transcode and our 16-bit copy of it.
+    check_memory(|| name.clone(), texels.saturating_mul(4 + 8)).map_err(|e| e.to_string())?;
+    let rgba = transcoder
+        .transcode(0, TargetFormat::Rgba32, DecodeFlags::NONE)
+        .map_err(failed)?;
+    if width == 0 || height == 0 || rgba.len() as u64 != texels * 4 {
+        return Err(format!(
+            "holds a {width}×{height} image it does not deliver"
+        ));
+    }
+    Ok(Texture {
+        name,
+        width,
+        height,
+        texels: rgba
+            .chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2], p[3]].map(|c| u16::from(c) * 257))
+            .collect(),
     })
 }
 

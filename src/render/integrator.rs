@@ -138,6 +138,12 @@ impl Renderer<'_> {
             let cos_o = s.geometric_normal.dot(wo);
             let front = cos_o > 0.0;
             let shading = self.shade(&s, front);
+            if material.unlit {
+                if matches!(arrival, Arrival::Specular) {
+                    result.radiance += beta * shading.base_colour;
+                }
+                break;
+            }
 
             // Emission reached by the previous bounce.
             if material.is_emissive() && (front || material.double_sided) {

@@ -17,6 +17,8 @@ pub struct Shading {
     pub bsdf: Bsdf,
     /// Emitted radiance.
     pub emission: Vec3,
+    /// The base colour with its texture and vertex colour (what an unlit surface shows).
+    pub base_colour: Vec3,
     /// Unit shading normal, normal-mapped where the material says so (not yet turned to
     /// any side).
     pub normal: Vec3,
@@ -62,6 +64,7 @@ impl Renderer<'_> {
             return Shading {
                 bsdf: self.bsdfs[s.material][usize::from(!front)],
                 emission: material.emission,
+                base_colour: material.pbr.base_colour,
                 normal: s.shading_normal,
                 coat_normal: None,
             };
@@ -103,6 +106,7 @@ impl Renderer<'_> {
         Shading {
             bsdf: Bsdf::new(&pbr, front),
             emission,
+            base_colour: pbr.base_colour,
             normal,
             coat_normal: mapped(&textures.clearcoat_normal, textures.clearcoat_normal_scale),
         }

@@ -201,6 +201,11 @@ pub struct Material {
     /// still scatters, emits and casts shadows for every other ray: a lamp's shape, which
     /// Cycles does not show to the camera.
     pub camera_visible: bool,
+    /// `KHR_materials_unlit`: the surface is its base colour (× texture × vertex colour),
+    /// seen as that radiance by camera rays and through mirrors and glass (delta bounces);
+    /// it scatters nothing and lights nothing else, and casts shadows like any opaque
+    /// surface. Blender's glTF importer shows it to camera rays only.
+    pub unlit: bool,
 }
 
 impl Material {
@@ -217,6 +222,7 @@ impl Material {
             alpha_mode: AlphaMode::Opaque,
             absorption: Vec3::ZERO,
             camera_visible: true,
+            unlit: false,
         }
     }
 

@@ -154,6 +154,7 @@ impl GltfLoader {
             alpha_mode,
             absorption,
             camera_visible: true,
+            unlit: material.extension_value("KHR_materials_unlit").is_some(),
         }
     }
 
@@ -210,7 +211,9 @@ impl GltfLoader {
         transform: Option<gltf::texture::TextureTransform>,
         material: &str,
     ) -> Option<TextureRef> {
-        let image = self.image_texture(&texture_image(document, texture)?)?;
+        let image = texture_images(document, texture)
+            .iter()
+            .find_map(|image| self.image_texture(image))?;
         let texcoord = transform
             .as_ref()
             .and_then(|t| t.tex_coord())
@@ -293,20 +296,18 @@ impl GltfLoader {
 /// image in its `source`; `source` itself is then a fallback, or absent).
 const IMAGE_EXTENSIONS: [&str; 2] = ["KHR_texture_basisu", "EXT_texture_webp"];
 
-/// The image a texture shows: the first image extension's, else its own `source`.
-fn texture_image<'a>(
+/// The images a texture may show, best first: the image extensions' (KTX2, WebP), then
+/// its own `source`, which the extensions keep as a fallback for readers without them.
+fn texture_images<'a>(
     document: &'a gltf::Document,
     texture: &gltf::Texture,
-) -> Option<gltf::Image<'a>> {
+) -> Vec<gltf::Image<'a>> {
     IMAGE_EXTENSIONS
         .iter()
         .filter_map(|name| texture.extension_value(name)?["source"].as_u64())
-        .find_map(|i| document.images().nth(i as usize))
-        .or_else(|| {
-            texture
-                .source()
-                .and_then(|s| document.images().nth(s.index()))
-        })
+        .chain(texture.source().map(|s| s.index() as u64))
+        .filter_map(|i| document.images().nth(i as usize))
+        .collect()
 }
 
 /// A number in extension JSON, or `default` when absent or not finite.
