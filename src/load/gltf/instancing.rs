@@ -23,10 +23,9 @@ pub(super) fn instance_transforms(
         let Some(index) = extension["attributes"][name].as_u64() else {
             return Ok(None);
         };
-        let accessor = document
-            .accessors()
-            .nth(index as usize)
-            .ok_or(format!("{EXTENSION}: {name} accessor {index} does not exist"))?;
+        let accessor = document.accessors().nth(index as usize).ok_or(format!(
+            "{EXTENSION}: {name} accessor {index} does not exist"
+        ))?;
         read_floats(&accessor, buffers)
             .map(Some)
             .map_err(|why| format!("{EXTENSION}: {name}: {why}"))
@@ -39,18 +38,25 @@ pub(super) fn instance_transforms(
         .filter_map(|a| a.as_ref().map(|a| a.len()))
         .collect();
     let Some(&count) = counts.first() else {
-        return Err(format!("{EXTENSION} without TRANSLATION, ROTATION or SCALE"));
+        return Err(format!(
+            "{EXTENSION} without TRANSLATION, ROTATION or SCALE"
+        ));
     };
     if counts.iter().any(|&n| n != count) {
         return Err(format!(
             "{EXTENSION}: its attributes have different counts ({counts:?})"
         ));
     }
-    check_memory(|| format!("{EXTENSION} instances"), bytes_of::<Mat4>(count as u64))
-        .map_err(|e| e.to_string())?;
+    check_memory(
+        || format!("{EXTENSION} instances"),
+        bytes_of::<Mat4>(count as u64),
+    )
+    .map_err(|e| e.to_string())?;
     let transforms = (0..count)
         .map(|i| {
-            let t = translation.as_ref().map_or(Vec3::ZERO, |a| Vec3::from(a.get::<3>(i)));
+            let t = translation
+                .as_ref()
+                .map_or(Vec3::ZERO, |a| Vec3::from(a.get::<3>(i)));
             let r = rotation.as_ref().map_or(Quat::IDENTITY, |a| {
                 let q = Quat::from_array(a.get::<4>(i));
                 let length = q.length();
@@ -60,7 +66,9 @@ pub(super) fn instance_transforms(
                     Quat::IDENTITY
                 }
             });
-            let s = scale.as_ref().map_or(Vec3::ONE, |a| Vec3::from(a.get::<3>(i)));
+            let s = scale
+                .as_ref()
+                .map_or(Vec3::ONE, |a| Vec3::from(a.get::<3>(i)));
             Mat4::from_scale_rotation_translation(s, r, t)
         })
         .collect();

@@ -331,8 +331,11 @@ impl GltfLoader {
                         source.clone()
                     };
                     for &our_mesh in &ours {
-                        self.builder
-                            .add_instance(our_mesh, Affine3A::from_mat4(placed), name.clone());
+                        self.builder.add_instance(
+                            our_mesh,
+                            Affine3A::from_mat4(placed),
+                            name.clone(),
+                        );
                     }
                 }
             }
