@@ -1,9 +1,9 @@
 //! glTF materials and their textures, as scene materials (the README's table).
 
-use glam::{Affine2, Vec2, Vec3};
+use glam::{Affine2, Vec2, Vec3, Vec4};
 
 use super::files::{image_bytes, is_data_uri};
-use super::{GltfLoader, MAX_UV_SETS, texture_transform};
+use super::{GltfLoader, MAX_UV_SETS, spec_gloss, texture_transform};
 use crate::load::images::decode_texture;
 use crate::scene::{
     AlphaMode, ChannelRef, Filter, Material, MaterialTextures, Pbr, TextureRef, Wrap,
@@ -32,7 +32,7 @@ impl GltfLoader {
             )
         };
         let pbr_gltf = material.pbr_metallic_roughness();
-        let [r, g, b, alpha] = pbr_gltf.base_color_factor();
+        let [r, g, b, mut alpha] = pbr_gltf.base_color_factor();
         let mut pbr = Pbr {
             base_colour: Vec3::new(r, g, b),
             metallic: pbr_gltf.metallic_factor(),
@@ -120,6 +120,21 @@ impl GltfLoader {
                 sheen,
                 &["sheenColorTexture", "sheenRoughnessTexture"],
             );
+        }
+        if let Some(sg) = material.extension_value(spec_gloss::EXTENSION) {
+            // It replaces pbrMetallicRoughness; its diffuse texture multiplies the converted
+            // base colour (exact while the conversion finds no metal, as for F0 = 0.04).
+            let [dr, dg, db, da] = json_vec4(&sg["diffuseFactor"], [1.0; 4]);
+            let m = spec_gloss::convert(
+                Vec4::new(dr, dg, db, da),
+                json_vec3(&sg["specularFactor"], Vec3::ONE),
+                json_f32(&sg["glossinessFactor"], 1.0),
+            );
+            (pbr.base_colour, pbr.metallic, pbr.roughness, alpha) =
+                (m.base_colour, m.metallic, m.roughness, m.alpha);
+            textures.base_colour = self.json_texture(document, &sg["diffuseTexture"], &name);
+            (textures.metallic, textures.roughness) = (None, None);
+            self.warn_unread_textures(&name, sg, &["specularGlossinessTexture"]);
         }
         let alpha_mode = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
@@ -327,6 +342,14 @@ fn json_vec3(value: &gltf::json::Value, default: Vec3) -> Vec3 {
             json_f32(y, default.y),
             json_f32(z, default.z),
         ),
+        _ => default,
+    }
+}
+
+/// A four-number array in extension JSON, or `default`.
+fn json_vec4(value: &gltf::json::Value, default: [f32; 4]) -> [f32; 4] {
+    match value.as_array().map(Vec::as_slice) {
+        Some(v @ [_, _, _, _]) => std::array::from_fn(|i| json_f32(&v[i], default[i])),
         _ => default,
     }
 }

@@ -15,6 +15,7 @@ mod instancing;
 mod material;
 mod meshopt;
 mod primitive;
+mod spec_gloss;
 
 use files::{SceneFiles, read_buffers};
 
@@ -40,6 +41,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_texture_basisu",
     "KHR_materials_unlit",
     "EXT_mesh_gpu_instancing",
+    "KHR_materials_pbrSpecularGlossiness",
 ];
 
 /// Texture-coordinate sets read (`TEXCOORD_0` to `TEXCOORD_3`).

@@ -1,0 +1,236 @@
+//! glTF extensions and storage forms read by hand-built files whose answers are known:
+//! quantised attributes (`KHR_mesh_quantization`), sparse accessors without a bufferView,
+//! `EXT_mesh_gpu_instancing`, `KHR_materials_unlit` and
+//! `KHR_materials_pbrSpecularGlossiness`.
+
+mod binary;
+mod image_stats;
+
+use std::path::{Path, PathBuf};
+
+use glam::{Quat, Vec3};
+use gridtrace::load::load_scene;
+use serde_json::{Value, json};
+
+/// Writes `document` with `buffer` as its only buffer, in a base64 data URI.
+fn write(dir: &Path, name: &str, buffer: &[u8], mut document: Value) -> PathBuf {
+    document["asset"] = json!({"version": "2.0"});
+    document["buffers"] = json!([{
+        "uri": format!("data:application/octet-stream;base64,{}", base64::encode(buffer)),
+        "byteLength": buffer.len()
+    }]);
+    let path = dir.join(name);
+    std::fs::write(&path, serde_json::to_vec_pretty(&document).unwrap()).unwrap();
+    path
+}
+
+fn i16s(values: &[i16]) -> Vec<u8> {
+    values.iter().flat_map(|v| v.to_le_bytes()).collect()
+}
+
+fn f32s(values: &[f32]) -> Vec<u8> {
+    values.iter().flat_map(|v| v.to_le_bytes()).collect()
+}
+
+#[test]
+fn quantised_attributes_and_sparse_accessors_without_a_view_are_read() {
+    // Positions: i16, not normalised, 8-byte stride (6 bytes + 2 of padding), scaled by the
+    // node; normals: normalised i8 with a 4-byte stride; u16 indices.
+    let mut buffer = i16s(&[
+        -100, -100, 0, 0, 100, -100, 0, 0, 100, 100, 0, 0, -100, 100, 0, 0,
+    ]);
+    buffer.extend([0u8, 0, 127, 0].repeat(4));
+    buffer.extend(i16s(&[0, 1, 2, 0, 2, 3]));
+    // A sparse accessor over zeros: vertices 1 to 3 become a square's corners.
+    buffer.extend([1, 2, 3, 0]);
+    buffer.extend(f32s(&[5.0, 0.0, 0.0, 5.0, 5.0, 0.0, 0.0, 5.0, 0.0]));
+    let document = json!({
+        "extensionsUsed": ["KHR_mesh_quantization"],
+        "extensionsRequired": ["KHR_mesh_quantization"],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 32, "byteStride": 8},
+            {"buffer": 0, "byteOffset": 32, "byteLength": 16, "byteStride": 4},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 12},
+            {"buffer": 0, "byteOffset": 60, "byteLength": 3},
+            {"buffer": 0, "byteOffset": 64, "byteLength": 36}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5122, "count": 4, "type": "VEC3",
+             "min": [-100, -100, 0], "max": [100, 100, 0]},
+            {"bufferView": 1, "componentType": 5120, "normalized": true, "count": 4, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"},
+            {"componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [5, 5, 0],
+             "sparse": {"count": 3,
+                        "indices": {"bufferView": 3, "componentType": 5121},
+                        "values": {"bufferView": 4}}}
+        ],
+        "meshes": [
+            {"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]},
+            {"primitives": [{"attributes": {"POSITION": 3}, "indices": 2}]}
+        ],
+        "nodes": [{"mesh": 0, "scale": [0.01, 0.01, 0.01]}, {"mesh": 1}],
+        "scenes": [{"nodes": [0, 1]}]
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = load_scene(&write(dir.path(), "q.gltf", &buffer, document)).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let scene = loaded.scene;
+    let quantised = &scene.meshes[scene.instances[0].mesh];
+    assert_eq!(quantised.positions[2], Vec3::new(100.0, 100.0, 0.0));
+    assert!(quantised.normals.iter().all(|&n| n == Vec3::Z));
+    let corner = scene.instances[0]
+        .world_from_object
+        .transform_point3(quantised.positions[0]);
+    assert!(
+        (corner - Vec3::new(-1.0, -1.0, 0.0)).length() < 1e-6,
+        "{corner}"
+    );
+    let sparse = &scene.meshes[scene.instances[1].mesh];
+    assert_eq!(
+        sparse.positions,
+        [
+            Vec3::ZERO,
+            Vec3::new(5.0, 0.0, 0.0),
+            Vec3::new(5.0, 5.0, 0.0),
+            Vec3::new(0.0, 5.0, 0.0)
+        ]
+    );
+}
+
+#[test]
+fn gpu_instancing_places_every_copy() {
+    let mut buffer = f32s(&[-1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 0.0, 1.0, 0.0]);
+    buffer.extend(i16s(&[0, 1, 2, 0]));
+    // Three instances: translations, and rotations as normalised i16 quaternions.
+    buffer.extend(f32s(&[0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 0.0, 7.0, 0.0]));
+    let s = (std::f32::consts::FRAC_1_SQRT_2 * 32767.0).round() as i16;
+    buffer.extend(i16s(&[0, 0, 0, 32767, 0, s, 0, s, 32767, 0, 0, 0]));
+    let document = json!({
+        "extensionsUsed": ["EXT_mesh_gpu_instancing"],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 6},
+            {"buffer": 0, "byteOffset": 44, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 80, "byteLength": 24}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+             "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"},
+            {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC3"},
+            {"bufferView": 3, "componentType": 5122, "normalized": true, "count": 3, "type": "VEC4"}
+        ],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "nodes": [{"mesh": 0, "translation": [0, 0, -2],
+                   "extensions": {"EXT_mesh_gpu_instancing":
+                       {"attributes": {"TRANSLATION": 2, "ROTATION": 3}}}}],
+        "scenes": [{"nodes": [0]}]
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = load_scene(&write(dir.path(), "i.gltf", &buffer, document)).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let instances = &loaded.scene.instances;
+    assert_eq!(instances.len(), 3);
+    let expected = [
+        (Vec3::new(0.0, 0.0, -2.0), Quat::IDENTITY),
+        (
+            Vec3::new(5.0, 0.0, -2.0),
+            Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+        ),
+        (
+            Vec3::new(0.0, 7.0, -2.0),
+            Quat::from_rotation_x(std::f32::consts::PI),
+        ),
+    ];
+    for (instance, (translation, rotation)) in instances.iter().zip(expected) {
+        let (_, r, t) = instance.world_from_object.to_scale_rotation_translation();
+        assert!((t - translation).length() < 1e-5, "{t}");
+        assert!(r.angle_between(rotation) < 1e-3, "{r} vs {rotation}");
+    }
+}
+
+/// A quad filling the view of a camera 3 units in front of it, with `material`.
+fn quad_facing_camera(material: Value, extension: &str) -> (Vec<u8>, Value) {
+    let mut buffer = f32s(&[
+        -1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0,
+    ]);
+    buffer.extend(i16s(&[0, 1, 2, 0, 2, 3]));
+    let document = json!({
+        "extensionsUsed": [extension],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 12}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}
+        ],
+        "materials": [material],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.4, "aspectRatio": 1.0, "znear": 0.1}}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}],
+        "scenes": [{"nodes": [0, 1]}]
+    });
+    (buffer, document)
+}
+
+#[test]
+fn an_unlit_surface_shows_its_base_colour_whatever_the_light() {
+    let colour = [0.2, 0.5, 0.8];
+    let (buffer, document) = quad_facing_camera(
+        json!({"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.5, 0.8, 1.0]},
+               "extensions": {"KHR_materials_unlit": {}}}),
+        "KHR_materials_unlit",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(dir.path(), "u.gltf", &buffer, document);
+    for light in ["none", "4,4,4"] {
+        let out = dir.path().join(format!("u-{light}.exr"));
+        let result = binary::gridtrace(
+            &[
+                path.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--spp",
+                "1",
+                "--width",
+                "128",
+                "--height",
+                "128",
+                "--environment",
+                light,
+                "-q",
+            ],
+            dir.path(),
+        );
+        assert!(result.status.success(), "{}", binary::stderr(&result));
+        for pixel in image_stats::read_exr(&out) {
+            let error = (pixel - glam::DVec3::from(colour)).abs().max_element();
+            assert!(error < 1e-6, "{light}: {pixel} instead of {colour:?}");
+        }
+    }
+}
+
+#[test]
+fn specular_glossiness_becomes_metallic_roughness() {
+    let (buffer, document) = quad_facing_camera(
+        json!({"extensions": {"KHR_materials_pbrSpecularGlossiness": {
+            "diffuseFactor": [0.0, 0.0, 0.0, 1.0],
+            "specularFactor": [1.0, 0.77, 0.34],
+            "glossinessFactor": 0.8}}}),
+        "KHR_materials_pbrSpecularGlossiness",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = load_scene(&write(dir.path(), "sg.gltf", &buffer, document)).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let pbr = loaded.scene.materials[0].pbr;
+    assert!(pbr.metallic > 0.99, "{pbr:?}");
+    assert!(
+        (pbr.base_colour - Vec3::new(1.0, 0.77, 0.34))
+            .abs()
+            .max_element()
+            < 0.02
+    );
+    assert!((pbr.roughness - 0.2).abs() < 1e-6);
+}
