@@ -268,3 +268,83 @@ fn committed_gltf_files_pass_the_validator() {
         assert!(out.status.success() || blender_spot, "{report}");
     }
 }
+
+/// A copy of GLB file `path` at `out` with its JSON chunk edited by `edit`.
+fn edit_glb(path: &Path, out: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
+    let bytes = std::fs::read(path).unwrap();
+    let word = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap()) as usize;
+    let json_len = word(12);
+    let mut json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    edit(&mut json);
+    let mut text = serde_json::to_vec(&json).unwrap();
+    while text.len() % 4 != 0 {
+        text.push(b' ');
+    }
+    let rest = &bytes[20 + json_len..];
+    let mut glb = Vec::new();
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&((20 + text.len() + rest.len()) as u32).to_le_bytes());
+    glb.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(&text);
+    glb.extend_from_slice(rest);
+    std::fs::write(out, glb).unwrap();
+}
+
+/// Halves a byte length in JSON.
+fn halve(length: &mut serde_json::Value) {
+    *length = (length.as_u64().unwrap() / 2).into();
+}
+
+#[test]
+fn corrupt_compressed_streams_are_clean_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    // A Draco stream cut in half.
+    let draco = transform(dir.path(), "draco", &["draco"]);
+    let cut = dir.path().join("draco_truncated.glb");
+    edit_glb(&draco, &cut, |json| {
+        let view = json["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]
+            ["bufferView"]
+            .as_u64()
+            .unwrap() as usize;
+        halve(&mut json["bufferViews"][view]["byteLength"]);
+    });
+    let error = load_scene(&cut).unwrap_err().to_string();
+    assert!(
+        error.contains("draco_truncated.glb") && error.contains("Draco stream cannot be decoded"),
+        "{error}"
+    );
+    // Every meshopt stream cut in half.
+    let meshopt = transform(dir.path(), "meshopt", &["meshopt"]);
+    let cut = dir.path().join("meshopt_truncated.glb");
+    edit_glb(&meshopt, &cut, |json| {
+        for view in json["bufferViews"].as_array_mut().unwrap() {
+            if let Some(e) = view["extensions"].get_mut("EXT_meshopt_compression") {
+                halve(&mut e["byteLength"]);
+            }
+        }
+    });
+    let error = load_scene(&cut).unwrap_err().to_string();
+    assert!(
+        error.contains("meshopt_truncated.glb") && error.contains("stream is corrupt"),
+        "{error}"
+    );
+    // KTX2 images cut in half: each texture is neutral, with a warning naming the image.
+    let ktx = ktx2(dir.path(), "uastc");
+    let cut = dir.path().join("ktx2_truncated.glb");
+    edit_glb(&ktx, &cut, |json| {
+        for image in json["images"].as_array().unwrap().clone() {
+            let view = image["bufferView"].as_u64().unwrap() as usize;
+            halve(&mut json["bufferViews"][view]["byteLength"]);
+        }
+    });
+    let loaded = load_scene(&cut).unwrap();
+    assert!(!loaded.warnings.is_empty());
+    for warning in &loaded.warnings {
+        assert!(
+            warning.contains("ktx2_truncated.glb") && warning.contains("cannot be decoded as KTX2"),
+            "{warning}"
+        );
+    }
+}
