@@ -277,7 +277,7 @@ fn edit_glb(path: &Path, out: &Path, edit: impl FnOnce(&mut serde_json::Value)) 
     let mut json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
     edit(&mut json);
     let mut text = serde_json::to_vec(&json).unwrap();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let rest = &bytes[20 + json_len..];

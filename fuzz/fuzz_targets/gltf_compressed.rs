@@ -10,11 +10,11 @@ use libfuzzer_sys::fuzz_target;
 /// A GLB of `json` (spaces pad it) and `bin`.
 fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
     let mut text = json.as_bytes().to_vec();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let mut bin = bin.to_vec();
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let mut out = Vec::new();

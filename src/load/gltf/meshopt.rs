@@ -92,8 +92,8 @@ fn decode(
     stride: usize,
 ) -> Result<Vec<u8>, String> {
     let valid_stride = match mode {
-        "ATTRIBUTES" => stride % 4 == 0 && (4..=256).contains(&stride),
-        "TRIANGLES" => (stride == 2 || stride == 4) && count % 3 == 0,
+        "ATTRIBUTES" => stride.is_multiple_of(4) && (4..=256).contains(&stride),
+        "TRIANGLES" => (stride == 2 || stride == 4) && count.is_multiple_of(3),
         "INDICES" => stride == 2 || stride == 4,
         other => return Err(format!("unknown mode '{other}'")),
     };
