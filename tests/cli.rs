@@ -167,8 +167,14 @@ fn errors_are_one_line_with_exit_code_2() {
             "x.png",
         ),
         (
-            &[&asset("cornell_box.glb"), "--frame", "12"],
-            "only USD animation",
+            &[
+                &asset("cornell_box.glb"),
+                "--frame",
+                "12",
+                "--animation",
+                "Walk",
+            ],
+            "no animation 'Walk'",
         ),
     ];
     for (args, named) in cases {

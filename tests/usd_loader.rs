@@ -695,7 +695,7 @@ fn references_and_instances_are_composed() {
 /// The scene at `frame` (`None`: the stage's start), which must load without warnings.
 fn scene_at_frame(path: &Path, frame: Option<f64>) -> Scene {
     let options = LoadOptions {
-        usd_frame: frame,
+        frame: frame,
         ..LoadOptions::default()
     };
     let loaded = load_scene_with(path, &options).unwrap();
@@ -806,20 +806,6 @@ fn animated_stages_are_read_at_the_frame_asked_for() {
     assert!((ratio - 3.0).abs() < 1e-4, "{ratio}");
     let ratio = intensity(&middle) / intensity(&start);
     assert!((ratio - 2.0).abs() < 1e-4, "interpolated: {ratio}");
-}
-
-#[test]
-fn a_frame_for_a_gltf_scene_is_an_error() {
-    let options = LoadOptions {
-        usd_frame: Some(3.0),
-        ..LoadOptions::default()
-    };
-    let err = load_scene_with(Path::new("assets/cornell_box.glb"), &options).unwrap_err();
-    let message = err.to_string();
-    assert!(
-        message.contains("cornell_box.glb") && message.contains("only USD animation"),
-        "{message}"
-    );
 }
 
 /// Blender's own animation export (tools/blender/make_animated.py): a cube sliding 2 m, a

@@ -96,10 +96,21 @@ pub struct Args {
     #[arg(long)]
     pub inspect: bool,
 
-    /// USD time code (Blender writes frame numbers) at which to read an animated USD stage:
-    /// transforms, points, cameras and lights. [default: the stage's startTimeCode]
+    /// Frame at which to read an animated scene, as Blender numbers frames: a USD time code
+    /// (transforms, points, cameras, lights); for glTF the time FRAME ÷ --fps seconds
+    /// (node transforms, skins, morph weights). [default: USD's startTimeCode; glTF as
+    /// stored, unanimated]
     #[arg(long, value_name = "FRAME", allow_negative_numbers = true, value_parser = parse_frame)]
     pub frame: Option<f64>,
+
+    /// Frames per second turning --frame into glTF seconds (Blender's exporter writes
+    /// keyframes at frame ÷ its scene's frame rate). [default: 24, Blender's]
+    #[arg(long, value_name = "FPS", value_parser = parse_fps, requires = "frame")]
+    pub fps: Option<f64>,
+
+    /// The glTF animation --frame evaluates, by name or index. [default: the first]
+    #[arg(long, value_name = "NAME|INDEX", requires = "frame")]
+    pub animation: Option<String>,
 
     /// What glTF light intensities mean: the specification's candela and lux (Blender's
     /// "Standard" export), or Blender's "Unitless" or "Raw" lighting modes.
@@ -212,6 +223,15 @@ pub fn parse_number<T: std::str::FromStr + Copy>(
         .ok()
         .filter(|v| accepts(*v))
         .ok_or_else(|| format!("'{text}' is not {what}"))
+}
+
+/// A positive, finite frame rate.
+pub fn parse_fps(text: &str) -> Result<f64, String> {
+    parse_number(
+        text,
+        |x: f64| x.is_finite() && x > 0.0,
+        "a positive frame rate",
+    )
 }
 
 /// A finite frame number (USD time code).

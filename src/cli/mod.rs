@@ -73,7 +73,9 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         .ok_or_else(|| anyhow!("no scene file given"))?;
     let options = LoadOptions {
         gltf_light_units: args.gltf_light_units,
-        usd_frame: args.frame,
+        frame: args.frame,
+        fps: args.fps,
+        animation: args.animation.clone(),
         asset_paths: args.asset_path.clone(),
     };
     for dir in &args.asset_path {
@@ -398,10 +400,14 @@ fn load_options_label(options: &LoadOptions) -> String {
         .gltf_light_units
         .to_possible_value()
         .map_or_else(String::new, |v| v.get_name().to_string());
-    match options.usd_frame {
-        Some(frame) => format!("gltf-light-units={units} usd-frame={frame}"),
-        None => format!("gltf-light-units={units}"),
+    let mut label = format!("gltf-light-units={units}");
+    if let Some(frame) = options.frame {
+        label += &format!(" frame={frame} fps={}", options.frames_per_second());
     }
+    if let Some(animation) = &options.animation {
+        label += &format!(" animation={animation}");
+    }
+    label
 }
 
 /// `SCENE_STEM.exr` in the current folder; `SCENE_STEM.samples-A-B.exr` for a part.
@@ -502,11 +508,17 @@ mod tests {
     fn the_frame_is_part_of_the_render_identity() {
         let mut options = LoadOptions::default();
         let still = load_options_label(&options);
-        options.usd_frame = Some(12.0);
+        options.frame = Some(12.0);
         let frame12 = load_options_label(&options);
-        options.usd_frame = Some(12.5);
+        options.frame = Some(12.5);
         assert_ne!(still, frame12);
         assert_ne!(frame12, load_options_label(&options));
+        let frame12_5 = load_options_label(&options);
+        options.fps = Some(30.0);
+        assert_ne!(frame12_5, load_options_label(&options));
+        let fps30 = load_options_label(&options);
+        options.animation = Some("Walk".into());
+        assert_ne!(fps30, load_options_label(&options));
         assert!(parse_frame("-3.5").is_ok() && parse_frame("inf").is_err());
     }
 

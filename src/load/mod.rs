@@ -35,11 +35,23 @@ pub struct Loaded {
 pub struct LoadOptions {
     /// Units of glTF punctual light intensities.
     pub gltf_light_units: GltfLightUnits,
-    /// The USD time code (frame) to read animated attributes at; `None`: the stage's
-    /// `startTimeCode`. Only USD animation is evaluated, so other formats refuse it.
-    pub usd_frame: Option<f64>,
+    /// The frame to read an animated scene at: a USD time code; for glTF, the time
+    /// frame ÷ [`LoadOptions::fps`] seconds, as Blender's exporter writes keyframe times.
+    /// `None`: USD's `startTimeCode`, glTF's nodes as stored. PLY refuses it.
+    pub frame: Option<f64>,
+    /// Frames per second turning a frame into glTF time (`None`: 24, Blender's default).
+    pub fps: Option<f64>,
+    /// The glTF animation to evaluate, by name or index (`None`: the first).
+    pub animation: Option<String>,
     /// Folders a scene may read besides its own (`--asset-path`); see [`access`].
     pub asset_paths: Vec<PathBuf>,
+}
+
+impl LoadOptions {
+    /// The frame rate turning frames into glTF seconds.
+    pub fn frames_per_second(&self) -> f64 {
+        self.fps.unwrap_or(24.0)
+    }
 }
 
 /// What a glTF file's `KHR_lights_punctual` intensities mean. Blender's exporter offers all
@@ -138,12 +150,11 @@ fn load_by_format(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadErro
     let is_usd = [".usd", ".usda", ".usdc", ".usdz"]
         .iter()
         .any(|e| name.ends_with(e));
-    if options.usd_frame.is_some() && !is_usd {
+    let is_gltf = name.ends_with(".gltf") || name.ends_with(".glb");
+    if options.frame.is_some() && !is_usd && !is_gltf {
         return Err(LoadError::Invalid {
             path: path.to_path_buf(),
-            what: "a frame was asked for, but only USD animation is evaluated (glTF \
-                   animations are not read): export this frame as its own file"
-                .into(),
+            what: "a frame was asked for, but this format holds no animation".into(),
         });
     }
     if name.ends_with(".gltf") || name.ends_with(".glb") {

@@ -9,11 +9,14 @@ use glam::{Affine2, Affine3A, Mat4, Vec2, Vec3};
 use gltf::json::validation::Validate;
 
 mod accessor;
+mod animation;
+mod deform;
 mod draco;
 mod files;
 mod instancing;
 mod material;
 mod meshopt;
+mod nodes;
 mod primitive;
 mod spec_gloss;
 
@@ -105,6 +108,10 @@ pub fn load_bytes_with(
         missing_images: HashSet::new(),
         normal_mapped: Vec::new(),
         coloured_materials: HashSet::new(),
+        time: options
+            .frame
+            .map(|frame| (frame / options.frames_per_second()) as f32),
+        animation: options.animation.clone(),
         warnings,
     };
     loader.warn_about_unreadable_images(&document);
@@ -260,6 +267,10 @@ struct GltfLoader {
     /// Scene materials (glTF materials and the default one) used by a primitive with vertex
     /// colours.
     coloured_materials: HashSet<usize>,
+    /// The time (seconds) to pose animated nodes at; `None`: as stored.
+    time: Option<f32>,
+    /// The animation asked for by name or index (`None`: the first).
+    animation: Option<String>,
     warnings: Vec<String>,
 }
 
@@ -283,74 +294,6 @@ impl GltfLoader {
         *self
             .default_material
             .get_or_insert_with(|| self.builder.add_material(Material::default_grey("default")))
-    }
-
-    fn load_scene(&mut self, document: &gltf::Document) -> Result<(), LoadError> {
-        let scene = match document
-            .default_scene()
-            .or_else(|| document.scenes().next())
-        {
-            Some(s) => s,
-            None => return Err(self.invalid("the file has no scene".into())),
-        };
-        let mut stack: Vec<(gltf::Node, Mat4, usize)> =
-            scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
-        stack.reverse();
-        let mut visits = 0;
-        while let Some((node, parent, depth)) = stack.pop() {
-            visits += 1;
-            if depth > MAX_NODE_DEPTH || visits > MAX_NODE_VISITS {
-                return Err(self.invalid(format!(
-                    "node hierarchy too deep or too large at node {} (cyclic?)",
-                    node.index()
-                )));
-            }
-            let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-            if !world.is_finite() {
-                return Err(
-                    self.invalid(format!("node {} has a non-finite transform", node.index()))
-                );
-            }
-            let source = match node.name() {
-                Some(name) => format!("node {} '{name}'", node.index()),
-                None => format!("node {}", node.index()),
-            };
-            if let Some(mesh) = node.mesh() {
-                let copies = instancing::instance_transforms(&node, document, &self.buffers)
-                    .map_err(|why| self.invalid(format!("{source}: {why}")))?
-                    .unwrap_or_else(|| vec![Mat4::IDENTITY]);
-                let ours = self.meshes_of(document, &mesh)?;
-                for (i, copy) in copies.iter().enumerate() {
-                    let placed = world * *copy;
-                    if !placed.is_finite() {
-                        return Err(self.invalid(format!(
-                            "{source}: instance {i} has a non-finite transform"
-                        )));
-                    }
-                    let name = if copies.len() > 1 {
-                        format!("{source} instance {i}")
-                    } else {
-                        source.clone()
-                    };
-                    for &our_mesh in &ours {
-                        self.builder.add_instance(
-                            our_mesh,
-                            Affine3A::from_mat4(placed),
-                            name.clone(),
-                        );
-                    }
-                }
-            }
-            if let Some(camera) = node.camera() {
-                self.add_camera(&camera, world, &source);
-            }
-            if let Some(light) = node.light() {
-                self.add_light(&light, world, &source);
-            }
-            let children: Vec<_> = node.children().map(|c| (c, world, depth + 1)).collect();
-            stack.extend(children.into_iter().rev());
-        }
-        Ok(())
     }
 
     /// A `KHR_lights_punctual` light: at the node's origin, shining down its −Z axis,
@@ -448,24 +391,5 @@ impl GltfLoader {
             focal_length: None,
             source: source.to_string(),
         });
-    }
-
-    /// Our meshes for a glTF mesh, converting it the first time it is used.
-    fn meshes_of(
-        &mut self,
-        document: &gltf::Document,
-        mesh: &gltf::Mesh,
-    ) -> Result<Vec<usize>, LoadError> {
-        if let Some(ours) = self.meshes.get(&mesh.index()) {
-            return Ok(ours.clone());
-        }
-        let mut ours = Vec::new();
-        for primitive in mesh.primitives() {
-            if let Some(m) = self.convert_primitive(document, mesh, &primitive)? {
-                ours.push(self.builder.add_full_mesh(m));
-            }
-        }
-        self.meshes.insert(mesh.index(), ours.clone());
-        Ok(ours)
     }
 }

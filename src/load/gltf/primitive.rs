@@ -6,6 +6,7 @@ use glam::{Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
 
 use super::accessor::{Elements, read_floats, read_indices};
+use super::deform::{self, Deformation};
 use super::draco::{self, DracoGeometry};
 use super::{GltfLoader, MAX_UV_SETS};
 use crate::load::LoadError;
@@ -52,6 +53,11 @@ impl<'a> VertexSource<'a> {
         }
     }
 
+    /// Any accessor of the file (morph targets), as numbers.
+    pub fn read(&self, accessor: &gltf::Accessor) -> Result<Elements, String> {
+        read_floats(accessor, self.buffers)
+    }
+
     /// The corner indices, or `None` for non-indexed geometry.
     pub fn indices(&mut self) -> Result<Option<Vec<u32>>, String> {
         if let Some(draco) = &mut self.draco {
@@ -70,6 +76,7 @@ impl GltfLoader {
         document: &gltf::Document,
         mesh: &gltf::Mesh,
         primitive: &gltf::Primitive,
+        deformation: Deformation,
     ) -> Result<Option<Mesh>, LoadError> {
         let name = format!(
             "mesh {} '{}' primitive {}",
@@ -95,7 +102,7 @@ impl GltfLoader {
         let Some(positions) = source.attribute("POSITION").map_err(invalid)? else {
             return Err(invalid("no POSITION attribute".into()));
         };
-        let positions: Vec<Vec3> = (0..positions.len())
+        let mut positions: Vec<Vec3> = (0..positions.len())
             .map(|i| Vec3::from(positions.get::<3>(i)))
             .collect();
         let corners: Vec<u32> = match source.indices().map_err(invalid)? {
@@ -108,18 +115,29 @@ impl GltfLoader {
                 positions.len()
             )));
         }
-        let per_vertex = |e: Option<Elements>| e.filter(|e| e.len() == positions.len());
-        let normals: Vec<Vec3> = per_vertex(source.attribute("NORMAL").map_err(invalid)?)
-            .map(|n| {
-                (0..n.len())
-                    .map(|i| {
-                        Vec3::from(n.get::<3>(i))
-                            .try_normalize()
-                            .unwrap_or(Vec3::ZERO)
-                    })
-                    .collect()
-            })
+        let count = positions.len();
+        let per_vertex = move |e: Option<Elements>| e.filter(|e| e.len() == count);
+        let mut normals: Vec<Vec3> = per_vertex(source.attribute("NORMAL").map_err(invalid)?)
+            .map(|n| (0..n.len()).map(|i| Vec3::from(n.get::<3>(i))).collect())
             .unwrap_or_default();
+        let mut tangents: Vec<Vec4> = per_vertex(source.attribute("TANGENT").map_err(invalid)?)
+            .map(|t| (0..t.len()).map(|i| Vec4::from(t.get::<4>(i))).collect())
+            .unwrap_or_default();
+        if !deformation.is_rest() {
+            deform::apply(
+                &mut source,
+                primitive,
+                deformation,
+                &mut positions,
+                &mut normals,
+                &mut tangents,
+            )
+            .map_err(invalid)?;
+        }
+        let normals: Vec<Vec3> = normals
+            .iter()
+            .map(|n| n.try_normalize().unwrap_or(Vec3::ZERO))
+            .collect();
         // Without (usable) normals, glTF asks for flat shading: empty means face normals.
         let normals = if normals.iter().all(|n| *n != Vec3::ZERO) {
             normals
@@ -152,9 +170,6 @@ impl GltfLoader {
                     })
                     .collect()
             })
-            .unwrap_or_default();
-        let tangents: Vec<Vec4> = per_vertex(source.attribute("TANGENT").map_err(invalid)?)
-            .map(|t| (0..t.len()).map(|i| Vec4::from(t.get::<4>(i))).collect())
             .unwrap_or_default();
         let indices = triangles(primitive.mode(), &corners);
         let leftover = if primitive.mode() == Mode::Triangles {

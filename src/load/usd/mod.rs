@@ -41,13 +41,13 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
 /// Loads a USD stage at time code `time` with default options; see [`load_with`].
 pub fn load_at(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
     let options = LoadOptions {
-        usd_frame: time,
+        frame: time,
         ..LoadOptions::default()
     };
     load_with(path, &options)
 }
 
-/// Loads a USD stage as it is at time code `options.usd_frame` (Blender writes frame
+/// Loads a USD stage as it is at time code `options.frame` (Blender writes frame
 /// numbers), or at the stage's `startTimeCode` (0 if unauthored): every attribute with time
 /// samples — transforms, points, camera and light settings — is evaluated there, held or
 /// linearly interpolated as the stage says; attributes without samples read their default.
@@ -59,7 +59,7 @@ pub fn load_at(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
 /// becomes an error naming the file instead of taking the program down.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError> {
     let roots = AssetRoots::for_scene(path, &options.asset_paths);
-    let time = options.usd_frame;
+    let time = options.frame;
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         if probe::may_hold_binary_layers(path) {
             probe::probe_stage(path, || read_stage(path, time, &roots).is_ok())?;
