@@ -79,3 +79,31 @@ fn usd_crashers_are_errors() {
         );
     }
 }
+
+/// KTX2 images the `gltf_compressed` target found aborting the process (a Zstandard level
+/// whose header claims exabytes): as a glTF texture, each is a warning naming the image.
+#[test]
+fn ktx2_crashers_are_warnings() {
+    let cases = inputs("ktx2");
+    assert!(!cases.is_empty(), "the ktx2 crasher corpus is missing");
+    for (name, bytes) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("image.ktx2"), &bytes).unwrap();
+        let document = r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_texture_basisu"],
+            "images":[{"uri":"image.ktx2"}],
+            "textures":[{"extensions":{"KHR_texture_basisu":{"source":0}}}],
+            "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+            "scenes":[{"nodes":[]}]}"#;
+        let path = dir.path().join("scene.gltf");
+        std::fs::write(&path, document).unwrap();
+        let loaded = gltf::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(
+            loaded
+                .warnings
+                .iter()
+                .any(|w| w.contains("image 0") && w.contains("cannot be decoded as KTX2")),
+            "{name}: {:?}",
+            loaded.warnings
+        );
+    }
+}

@@ -33,6 +33,7 @@ const KTX2_MAGIC: &[u8] = b"\xabKTX 20\xbb\r\n\x1a\n";
 fn decode_basis(name: String, bytes: &[u8]) -> Result<Texture, String> {
     use basisu::{DecodeFlags, TargetFormat, Transcoder};
     let failed = |e: basisu::Error| format!("cannot be decoded as KTX2 ({e:?})");
+    check_ktx2_levels(bytes)?;
     let transcoder = Transcoder::new(bytes).map_err(failed)?;
     let (width, height) = transcoder.base_dimensions();
     let texels = u64::from(width) * u64::from(height);
@@ -55,6 +56,54 @@ fn decode_basis(name: String, bytes: &[u8]) -> Result<Texture, String> {
             .map(|p| [p[0], p[1], p[2], p[3]].map(|c| u16::from(c) * 257))
             .collect(),
     })
+}
+
+/// Refuses a Zstandard-supercompressed KTX2 file whose level index claims more
+/// uncompressed bytes than its image can hold (16 bytes per 4×4 block, UASTC's size, for
+/// every layer and face) or the memory budget allows: the transcoder allocates that length
+/// before inflating (found by fuzzing). Fields from the KTX 2.0 header (§3) and level
+/// index (§3.9).
+fn check_ktx2_levels(bytes: &[u8]) -> Result<(), String> {
+    let word = |at: usize| -> Option<u64> {
+        let b = bytes.get(at..at + 4)?;
+        Some(u64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+    };
+    let long = |at: usize| -> Option<u64> { Some(word(at)? | (word(at + 4)? << 32)) };
+    let header = (|| {
+        let (width, height) = (word(20)?, word(24)?.max(1));
+        let (layers, faces, levels, scheme) = (
+            word(32)?.max(1),
+            word(36)?.max(1),
+            word(40)?.max(1),
+            word(44)?,
+        );
+        Some((width, height, layers, faces, levels, scheme))
+    })();
+    let Some((width, height, layers, faces, levels, scheme)) = header else {
+        return Err("is a truncated KTX2 file".into());
+    };
+    const ZSTANDARD: u64 = 2;
+    if scheme != ZSTANDARD {
+        return Ok(());
+    }
+    let most = width
+        .div_ceil(4)
+        .saturating_mul(height.div_ceil(4))
+        .saturating_mul(16)
+        .saturating_mul(layers)
+        .saturating_mul(faces);
+    for level in 0..levels.min(32) as usize {
+        let Some(uncompressed) = long(80 + 24 * level + 16) else {
+            return Err("is a truncated KTX2 file".into());
+        };
+        if uncompressed > most {
+            return Err(format!(
+                "cannot be decoded as KTX2 (level {level} claims {uncompressed} bytes for a {width}×{height} image)"
+            ));
+        }
+        check_memory(|| format!("KTX2 level {level}"), uncompressed).map_err(|e| e.to_string())?;
+    }
+    Ok(())
 }
 
 /// The latitude–longitude environment image in `bytes` (Radiance `.hdr`, OpenEXR, or any
