@@ -12,7 +12,8 @@ use glam::{Quat, Vec3};
 use gridtrace::load::load_scene;
 use serde_json::{Value, json};
 
-/// Writes `document` with `buffer` as its only buffer, in a base64 data URI.
+/// Writes `document` with `buffer` as its only buffer, in a base64 data URI, and checks it
+/// with Khronos' glTF-Validator (`tools/npm`, installed by `tools/setup-dev.sh`).
 fn write(dir: &Path, name: &str, buffer: &[u8], mut document: Value) -> PathBuf {
     document["asset"] = json!({"version": "2.0"});
     document["buffers"] = json!([{
@@ -21,6 +22,18 @@ fn write(dir: &Path, name: &str, buffer: &[u8], mut document: Value) -> PathBuf 
     }]);
     let path = dir.join(name);
     std::fs::write(&path, serde_json::to_vec_pretty(&document).unwrap()).unwrap();
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/npm/validate.mjs");
+    let out = std::process::Command::new("node")
+        .arg(validator)
+        .arg(&path)
+        .output()
+        .expect("node runs (tools/setup-dev.sh)");
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
     path
 }
 

@@ -348,3 +348,45 @@ fn corrupt_compressed_streams_are_clean_errors() {
         );
     }
 }
+
+/// A file may carry compressed and uncompressed data together; when the compressed stream
+/// cannot be decoded, the uncompressed data is used, with a warning.
+#[test]
+fn undecodable_streams_with_uncompressed_data_fall_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = load(&scene_path("textured"));
+    let out = dir.path().join("fallbacks.glb");
+    edit_glb(&scene_path("textured"), &out, |json| {
+        json["extensionsUsed"] =
+            serde_json::json!(["KHR_draco_mesh_compression", "EXT_meshopt_compression"]);
+        // A Draco "stream" that is really the first buffer view's bytes.
+        let primitive = &mut json["meshes"][0]["primitives"][0];
+        let attributes: serde_json::Map<String, serde_json::Value> = primitive["attributes"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .enumerate()
+            .map(|(i, k)| (k.clone(), i.into()))
+            .collect();
+        primitive["extensions"] = serde_json::json!({"KHR_draco_mesh_compression": {
+            "bufferView": 0, "attributes": attributes}});
+        // A meshopt "stream" of 8 bytes for the second buffer view, which keeps its data.
+        let view = &mut json["bufferViews"][1];
+        let count = view["byteLength"].as_u64().unwrap() / 4;
+        view["extensions"] = serde_json::json!({"EXT_meshopt_compression": {
+            "buffer": 0, "byteOffset": 0, "byteLength": 8, "byteStride": 4,
+            "count": count, "mode": "ATTRIBUTES"}});
+    });
+    let loaded = load_scene(&out).unwrap();
+    let said = loaded.warnings.join("\n");
+    assert!(
+        said.contains("Draco stream cannot be decoded")
+            && said.contains("using the uncompressed accessors"),
+        "{said}"
+    );
+    assert!(
+        said.contains("(meshopt)") && said.contains("using its uncompressed fallback"),
+        "{said}"
+    );
+    assert_eq!(world_triangles(&loaded.scene), world_triangles(&original));
+}

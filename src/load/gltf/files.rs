@@ -56,12 +56,13 @@ impl SceneFiles {
 
 /// Every buffer's bytes, in buffer order: the GLB binary chunk, a base64 data URI, or a file
 /// read through the policy, each holding at least its `byteLength` (glTF 2.0 §3.6.1), with
-/// meshopt-compressed views decoded in place.
+/// meshopt-compressed views decoded in place, and warnings about views whose uncompressed
+/// fallback is used.
 pub(super) fn read_buffers(
     document: &gltf::Document,
     mut blob: Option<Vec<u8>>,
     files: &mut SceneFiles,
-) -> Result<Vec<gltf::buffer::Data>, LoadError> {
+) -> Result<(Vec<gltf::buffer::Data>, Vec<String>), LoadError> {
     let path = files.asker.clone();
     let invalid = |what: String| LoadError::Invalid {
         path: path.clone(),
@@ -109,8 +110,13 @@ pub(super) fn read_buffers(
         }
         buffers.push(gltf::buffer::Data(data));
     }
-    super::meshopt::decode_views(document, &mut buffers).map_err(invalid)?;
-    Ok(buffers)
+    let mut warnings = Vec::new();
+    super::meshopt::decode_views(document, &mut buffers, &mut warnings).map_err(invalid)?;
+    let warnings = warnings
+        .into_iter()
+        .map(|w| format!("{}: {w}", path.display()))
+        .collect();
+    Ok((buffers, warnings))
 }
 
 /// An image's encoded bytes: a slice of a buffer view, a data URI, or a file read through

@@ -26,59 +26,76 @@ pub(super) fn is_fallback(buffer: &gltf::Buffer) -> bool {
     extension(|n| buffer.extension_value(n)).is_some_and(|e| e["fallback"].as_bool() == Some(true))
 }
 
-/// Decodes every compressed buffer view into its buffer.
+/// Decodes every compressed buffer view into its buffer. A view that cannot be decoded
+/// is an error, unless its buffer holds real bytes (not a `fallback` placeholder): then
+/// those are used, with a warning pushed on `warnings`.
 pub(super) fn decode_views(
     document: &gltf::Document,
     buffers: &mut [gltf::buffer::Data],
+    warnings: &mut Vec<String>,
 ) -> Result<(), String> {
     for view in document.views() {
-        let Some(e) = extension(|n| view.extension_value(n)) else {
-            continue;
-        };
-        let what = |why: String| format!("buffer view {} (meshopt): {why}", view.index());
-        let number = |key: &str| e[key].as_u64().map(|n| n as usize);
-        let (Some(source), Some(length), Some(stride), Some(count)) = (
-            number("buffer"),
-            number("byteLength"),
-            number("byteStride"),
-            number("count"),
-        ) else {
-            return Err(what(
-                "buffer, byteLength, byteStride and count are required".into(),
-            ));
-        };
-        let offset = number("byteOffset").unwrap_or(0);
-        let compressed = buffers
-            .get(source)
-            .and_then(|b| {
-                offset
-                    .checked_add(length)
-                    .and_then(|end| b.0.get(offset..end))
-            })
-            .ok_or_else(|| {
-                what(format!(
-                    "its compressed bytes are not inside buffer {source}"
-                ))
-            })?
-            .to_vec();
-        let mode = e["mode"].as_str().unwrap_or("");
-        let filter = e["filter"].as_str().unwrap_or("NONE");
-        let decoded_len = count
-            .checked_mul(stride)
-            .filter(|&n| n <= view.length())
-            .ok_or_else(|| {
-                what(format!(
-                    "{count} elements of {stride} bytes do not fit its {} bytes",
-                    view.length()
-                ))
-            })?;
-        let decoded = decode(&compressed, mode, filter, count, stride).map_err(what)?;
-        let target = buffers
-            .get_mut(view.buffer().index())
-            .and_then(|b| b.0.get_mut(view.offset()..view.offset() + decoded_len))
-            .ok_or_else(|| what(format!("it runs past buffer {}", view.buffer().index())))?;
-        target.copy_from_slice(&decoded[..decoded_len]);
+        if let Err(why) = decode_view(&view, buffers) {
+            if is_fallback(&view.buffer()) || extension(|n| view.extension_value(n)).is_none() {
+                return Err(why);
+            }
+            warnings.push(format!("{why}; using its uncompressed fallback"));
+        }
     }
+    Ok(())
+}
+
+/// Decodes one buffer view, if compressed, into its buffer.
+fn decode_view(
+    view: &gltf::buffer::View,
+    buffers: &mut [gltf::buffer::Data],
+) -> Result<(), String> {
+    let Some(e) = extension(|n| view.extension_value(n)) else {
+        return Ok(());
+    };
+    let what = |why: String| format!("buffer view {} (meshopt): {why}", view.index());
+    let number = |key: &str| e[key].as_u64().map(|n| n as usize);
+    let (Some(source), Some(length), Some(stride), Some(count)) = (
+        number("buffer"),
+        number("byteLength"),
+        number("byteStride"),
+        number("count"),
+    ) else {
+        return Err(what(
+            "buffer, byteLength, byteStride and count are required".into(),
+        ));
+    };
+    let offset = number("byteOffset").unwrap_or(0);
+    let compressed = buffers
+        .get(source)
+        .and_then(|b| {
+            offset
+                .checked_add(length)
+                .and_then(|end| b.0.get(offset..end))
+        })
+        .ok_or_else(|| {
+            what(format!(
+                "its compressed bytes are not inside buffer {source}"
+            ))
+        })?
+        .to_vec();
+    let mode = e["mode"].as_str().unwrap_or("");
+    let filter = e["filter"].as_str().unwrap_or("NONE");
+    let decoded_len = count
+        .checked_mul(stride)
+        .filter(|&n| n <= view.length())
+        .ok_or_else(|| {
+            what(format!(
+                "{count} elements of {stride} bytes do not fit its {} bytes",
+                view.length()
+            ))
+        })?;
+    let decoded = decode(&compressed, mode, filter, count, stride).map_err(what)?;
+    let target = buffers
+        .get_mut(view.buffer().index())
+        .and_then(|b| b.0.get_mut(view.offset()..view.offset() + decoded_len))
+        .ok_or_else(|| what(format!("it runs past buffer {}", view.buffer().index())))?;
+    target.copy_from_slice(&decoded[..decoded_len]);
     Ok(())
 }
 

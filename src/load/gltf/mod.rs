@@ -95,7 +95,8 @@ pub fn load_bytes_with(
     check_extensions(path, &document, &mut warnings)?;
     validate(&document).map_err(gltf_error)?;
     let mut files = SceneFiles::new(path, AssetRoots::for_scene(path, &options.asset_paths));
-    let buffers = read_buffers(&document, blob, &mut files)?;
+    let (buffers, buffer_warnings) = read_buffers(&document, blob, &mut files)?;
+    warnings.extend(buffer_warnings);
     let mut loader = GltfLoader {
         path: path.to_path_buf(),
         buffers,

@@ -25,13 +25,25 @@ impl<'a> VertexSource<'a> {
         primitive: &'a gltf::Primitive<'a>,
         document: &gltf::Document,
         buffers: &'a [gltf::buffer::Data],
-    ) -> Result<VertexSource<'a>, String> {
-        let draco = draco::decode(primitive, document, buffers)?;
-        Ok(VertexSource {
+    ) -> Result<(VertexSource<'a>, Option<String>), String> {
+        // A Draco stream that cannot be decoded falls back to the accessors' own data when
+        // every one of them has some (the extension allows files to carry both).
+        let has_fallback = primitive.attributes().all(|(_, a)| a.view().is_some())
+            && primitive.indices().is_none_or(|a| a.view().is_some());
+        let (draco, warning) = match draco::decode(primitive, document, buffers) {
+            Ok(draco) => (draco, None),
+            Err(why) if has_fallback => (
+                None,
+                Some(format!("{why}; using the uncompressed accessors")),
+            ),
+            Err(why) => return Err(why),
+        };
+        let source = VertexSource {
             primitive,
             buffers,
             draco,
-        })
+        };
+        Ok((source, warning))
     }
 
     /// The attribute named `semantic` (`"POSITION"`, `"TEXCOORD_1"`, ...), if present.
@@ -94,11 +106,14 @@ impl GltfLoader {
             ));
             return Ok(None);
         }
+        let path = self.path.clone();
         let invalid = |why: String| LoadError::Invalid {
-            path: self.path.clone(),
+            path: path.clone(),
             what: format!("{name}: {why}"),
         };
-        let mut source = VertexSource::new(primitive, document, &self.buffers).map_err(invalid)?;
+        let (mut source, fallback) =
+            VertexSource::new(primitive, document, &self.buffers).map_err(invalid)?;
+        let fallback = fallback.map(|warning| format!("{name}: {warning}"));
         let Some(positions) = source.attribute("POSITION").map_err(invalid)? else {
             return Err(invalid("no POSITION attribute".into()));
         };
@@ -177,6 +192,9 @@ impl GltfLoader {
         } else {
             0
         };
+        if let Some(warning) = fallback {
+            self.warn(warning);
+        }
         if leftover != 0 {
             self.warn(format!(
                 "{name}: {leftover} index(es) left over after the last whole triangle"
