@@ -80,8 +80,9 @@ fn usd_crashers_are_errors() {
     }
 }
 
-/// KTX2 images the `gltf_compressed` target found aborting the process (a Zstandard level
-/// whose header claims exabytes): as a glTF texture, each is a warning naming the image.
+/// KTX2 images the `gltf_compressed` target found taking the process down (a Zstandard
+/// level whose header claims exabytes; a key/value entry that makes the transcoder index
+/// past its input): as a glTF texture, each is a warning naming the image.
 #[test]
 fn ktx2_crashers_are_warnings() {
     let cases = inputs("ktx2");

@@ -4,6 +4,7 @@
 //! latitude–longitude maps into linear float [`EnvironmentMap`]s.
 
 use crate::limits::{check_memory, memory_budget};
+use crate::load::guard::catching_panics;
 use crate::scene::{EnvironmentMap, Texture, srgb_to_linear};
 
 /// The image in `bytes` (format guessed from its first bytes) as a texture named `name`.
@@ -34,14 +35,19 @@ fn decode_basis(name: String, bytes: &[u8]) -> Result<Texture, String> {
     use basisu::{DecodeFlags, TargetFormat, Transcoder};
     let failed = |e: basisu::Error| format!("cannot be decoded as KTX2 ({e:?})");
     check_ktx2_levels(bytes)?;
-    let transcoder = Transcoder::new(bytes).map_err(failed)?;
-    let (width, height) = transcoder.base_dimensions();
+    let (width, height, rgba) = catching_panics(|| {
+        let transcoder = Transcoder::new(bytes).map_err(failed)?;
+        let (width, height) = transcoder.base_dimensions();
+        let texels = u64::from(width) * u64::from(height);
+        // The 8-bit transcode and our 16-bit copy of it.
+        check_memory(|| name.clone(), texels.saturating_mul(4 + 8)).map_err(|e| e.to_string())?;
+        let rgba = transcoder
+            .transcode(0, TargetFormat::Rgba32, DecodeFlags::NONE)
+            .map_err(failed)?;
+        Ok::<_, String>((width, height, rgba))
+    })
+    .map_err(|why| format!("cannot be decoded as KTX2 (the transcoder failed: {why})"))??;
     let texels = u64::from(width) * u64::from(height);
-    // The 8-bit transcode and our 16-bit copy of it.
-    check_memory(|| name.clone(), texels.saturating_mul(4 + 8)).map_err(|e| e.to_string())?;
-    let rgba = transcoder
-        .transcode(0, TargetFormat::Rgba32, DecodeFlags::NONE)
-        .map_err(failed)?;
     if width == 0 || height == 0 || rgba.len() as u64 != texels * 4 {
         return Err(format!(
             "holds a {width}×{height} image it does not deliver"
@@ -148,7 +154,7 @@ fn decode(bytes: &[u8]) -> Result<image::DynamicImage, String> {
     let mut limits = image::Limits::default();
     limits.max_alloc = Some(memory_budget());
     reader.limits(limits);
-    reader
-        .decode()
+    catching_panics(|| reader.decode())
+        .map_err(|why| format!("cannot be decoded (the decoder failed: {why})"))?
         .map_err(|e| format!("cannot be decoded ({e})"))
 }

@@ -3,6 +3,7 @@
 pub mod access;
 mod error;
 pub mod gltf;
+pub mod guard;
 mod images;
 pub mod ply;
 mod polygon;

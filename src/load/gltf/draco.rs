@@ -12,6 +12,7 @@ use draco_core::{DecodeLimits, DecoderBuffer, Mesh, MeshDecoder};
 
 use super::accessor::{Elements, normalize_as};
 use crate::limits::memory_budget;
+use crate::load::guard::catching_panics;
 
 /// The extension's name.
 pub const EXTENSION: &str = "KHR_draco_mesh_compression";
@@ -58,12 +59,16 @@ pub(super) fn decode(
     let defaults = DecodeLimits::default();
     let limits = defaults.with_max_decoded_bytes(defaults.max_decoded_bytes.min(memory_budget()));
     let mut mesh = Mesh::new();
-    MeshDecoder::new()
-        .decode(
+    catching_panics(|| {
+        MeshDecoder::new().decode(
             &mut DecoderBuffer::new(stream).with_limits(limits),
             &mut mesh,
         )
-        .map_err(|e| format!("{EXTENSION}: the Draco stream cannot be decoded ({e})"))?;
+    })
+    .map_err(|why| {
+        format!("{EXTENSION}: the Draco stream cannot be decoded (the decoder failed: {why})")
+    })?
+    .map_err(|e| format!("{EXTENSION}: the Draco stream cannot be decoded ({e})"))?;
     let points = mesh.num_points();
     let mut attributes = HashMap::new();
     let Some(map) = extension["attributes"].as_object() else {

@@ -60,18 +60,13 @@ pub fn load_at(path: &Path, time: Option<f64>) -> Result<Loaded, LoadError> {
 pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError> {
     let roots = AssetRoots::for_scene(path, &options.asset_paths);
     let time = options.frame;
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+    crate::load::guard::catching_panics(|| {
         if probe::may_hold_binary_layers(path) {
             probe::probe_stage(path, || read_stage(path, time, &roots).is_ok())?;
         }
         read_stage(path, time, &roots)
-    }))
-    .unwrap_or_else(|panic| {
-        let why = panic
-            .downcast_ref::<String>()
-            .map(String::as_str)
-            .or_else(|| panic.downcast_ref::<&str>().copied())
-            .unwrap_or("unknown failure");
+    })
+    .unwrap_or_else(|why| {
         Err(LoadError::Invalid {
             path: path.to_path_buf(),
             what: format!("the USD reader failed: {why}"),
