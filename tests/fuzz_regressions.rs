@@ -82,7 +82,8 @@ fn usd_crashers_are_errors() {
 
 /// KTX2 images the `gltf_compressed` target found taking the process down (a Zstandard
 /// level whose header claims exabytes; a key/value entry that makes the transcoder index
-/// past its input): as a glTF texture, each is a warning naming the image.
+/// past its input; an ETC1S image four billion texels wide): as a glTF texture, each is a
+/// warning naming the image.
 #[test]
 fn ktx2_crashers_are_warnings() {
     let cases = inputs("ktx2");
@@ -102,7 +103,7 @@ fn ktx2_crashers_are_warnings() {
             loaded
                 .warnings
                 .iter()
-                .any(|w| w.contains("image 0") && w.contains("cannot be decoded as KTX2")),
+                .any(|w| w.contains("image 0") && w.contains("KTX2")),
             "{name}: {:?}",
             loaded.warnings
         );

@@ -247,3 +247,82 @@ fn specular_glossiness_becomes_metallic_roughness() {
     );
     assert!((pbr.roughness - 0.2).abs() < 1e-6);
 }
+
+/// A 2×1 PNG (RGBA, 8-bit) as a data URI.
+fn png_uri(texels: [[u8; 4]; 2]) -> String {
+    let image = image::RgbaImage::from_fn(2, 1, |x, _| image::Rgba(texels[x as usize]));
+    let mut bytes = Vec::new();
+    image
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .unwrap();
+    format!("data:image/png;base64,{}", base64::encode(bytes))
+}
+
+#[test]
+fn specular_glossiness_textures_are_baked_texel_by_texel() {
+    // Texel 0: black diffuse under a gold specular, glossy: a polished metal. Texel 1: an
+    // orange diffuse under a dark specular (F0 ≈ 0.003), half glossy: a dielectric.
+    let diffuse = png_uri([[0, 0, 0, 255], [200, 100, 50, 128]]);
+    let spec_gloss = png_uri([[255, 196, 87, 255], [10, 10, 10, 128]]);
+    let (buffer, mut document) = quad_facing_camera(
+        json!({"extensions": {"KHR_materials_pbrSpecularGlossiness": {
+            "diffuseTexture": {"index": 0},
+            "specularGlossinessTexture": {"index": 1}}}}),
+        "KHR_materials_pbrSpecularGlossiness",
+    );
+    document["images"] = json!([{"uri": diffuse}, {"uri": spec_gloss}]);
+    document["textures"] = json!([{"source": 0}, {"source": 1}]);
+    document["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(2);
+    let uv_offset = buffer.len();
+    let mut buffer = buffer;
+    buffer.extend(f32s(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]));
+    document["bufferViews"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"buffer": 0, "byteOffset": uv_offset, "byteLength": 32}));
+    document["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"}));
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = load_scene(&write(dir.path(), "sgt.gltf", &buffer, document)).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let scene = loaded.scene;
+    let material = &scene.materials[0];
+    let base = &scene.textures[material.textures.base_colour.unwrap().texture];
+    let metal_rough = &scene.textures[material.textures.metallic.unwrap().texture.texture];
+    let unit = |c: u16| f32::from(c) / 65535.0;
+    // Texel 0: metal, smooth, base colour the specular colour.
+    assert!(
+        unit(metal_rough.texels[0][2]) > 0.99,
+        "{:?}",
+        metal_rough.texels[0]
+    );
+    assert!(unit(metal_rough.texels[0][1]) < 1e-4);
+    for c in 0..3 {
+        let expected = [255u16, 196, 87][c] * 257;
+        assert!(
+            base.texels[0][c].abs_diff(expected) <= 3 * 257,
+            "{:?}",
+            base.texels[0]
+        );
+    }
+    // Texel 1: no metal, roughness 0.5, the diffuse colour brightened by 1/(1 − 0.04) and
+    // dimmed by 1 − F0, alpha kept.
+    assert_eq!(metal_rough.texels[1][2], 0);
+    assert!((unit(metal_rough.texels[1][1]) - (1.0 - 128.0 / 255.0)).abs() < 1e-3);
+    let f0 = gridtrace::scene::srgb_to_linear(10.0 / 255.0);
+    for c in 0..3 {
+        let ours = gridtrace::scene::srgb_to_linear(unit(base.texels[1][c]));
+        let diffuse = gridtrace::scene::srgb_to_linear([200.0f32, 100.0, 50.0][c] / 255.0);
+        let expected = diffuse * (1.0 - f0) / 0.96;
+        assert!(
+            (ours / expected - 1.0).abs() < 0.01,
+            "channel {c}: {ours} vs {expected}"
+        );
+    }
+    assert_eq!(base.texels[1][3], 128 * 257);
+}

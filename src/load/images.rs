@@ -34,7 +34,7 @@ const KTX2_MAGIC: &[u8] = b"\xabKTX 20\xbb\r\n\x1a\n";
 fn decode_basis(name: String, bytes: &[u8]) -> Result<Texture, String> {
     use basisu::{DecodeFlags, TargetFormat, Transcoder};
     let failed = |e: basisu::Error| format!("cannot be decoded as KTX2 ({e:?})");
-    check_ktx2_levels(bytes)?;
+    check_ktx2_header(bytes)?;
     let (width, height, rgba) = catching_panics(|| {
         let transcoder = Transcoder::new(bytes).map_err(failed)?;
         let (width, height) = transcoder.base_dimensions();
@@ -64,12 +64,11 @@ fn decode_basis(name: String, bytes: &[u8]) -> Result<Texture, String> {
     })
 }
 
-/// Refuses a Zstandard-supercompressed KTX2 file whose level index claims more
-/// uncompressed bytes than its image can hold (16 bytes per 4×4 block, UASTC's size, for
-/// every layer and face) or the memory budget allows: the transcoder allocates that length
-/// before inflating (found by fuzzing). Fields from the KTX 2.0 header (§3) and level
-/// index (§3.9).
-fn check_ktx2_levels(bytes: &[u8]) -> Result<(), String> {
+/// Refuses a KTX2 file whose header claims an image larger than the memory budget allows,
+/// or a Zstandard-supercompressed level longer than its image can hold (16 bytes per 4×4
+/// block, UASTC's size, for every layer and face): the transcoder allocates both before
+/// decoding (found by fuzzing). Fields from the KTX 2.0 header (§3) and level index (§3.9).
+fn check_ktx2_header(bytes: &[u8]) -> Result<(), String> {
     let word = |at: usize| -> Option<u64> {
         let b = bytes.get(at..at + 4)?;
         Some(u64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])))
@@ -88,6 +87,11 @@ fn check_ktx2_levels(bytes: &[u8]) -> Result<(), String> {
     let Some((width, height, layers, faces, levels, scheme)) = header else {
         return Err("is a truncated KTX2 file".into());
     };
+    // The transcoder allocates by the image's size before decoding anything; so do we
+    // (its 8-bit output and our 16-bit copy).
+    let texels = width.saturating_mul(height).saturating_mul(layers).saturating_mul(faces);
+    check_memory(|| format!("a {width}×{height} KTX2 image"), texels.saturating_mul(12))
+        .map_err(|e| e.to_string())?;
     const ZSTANDARD: u64 = 2;
     if scheme != ZSTANDARD {
         return Ok(());

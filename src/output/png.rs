@@ -3,16 +3,7 @@
 use image::ImageEncoder;
 
 use crate::render::Image;
-
-/// The sRGB encoding of a linear value (IEC 61966-2-1), clamped to [0, 1].
-pub fn linear_to_srgb(x: f32) -> f32 {
-    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
-    if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        (1.055 * x.powf(1.0 / 2.4) - 0.055).min(1.0)
-    }
-}
+use crate::scene::linear_to_srgb;
 
 /// The image as PNG bytes.
 pub fn encode(image: &Image) -> Result<Vec<u8>, String> {

@@ -90,6 +90,11 @@ impl SceneBuilder {
         &mut self.scene.materials[index]
     }
 
+    /// A texture added before.
+    pub fn texture(&self, index: usize) -> &Texture {
+        &self.scene.textures[index]
+    }
+
     /// Adds a decoded image; returns its index for [`super::TextureRef::texture`].
     pub fn add_texture(&mut self, texture: Texture) -> usize {
         self.scene.textures.push(texture);

@@ -18,7 +18,7 @@ pub use environment::{Environment, EnvironmentMap, blender_world_rotation, map_d
 pub use light::{Light, LightKind};
 pub use material::{AlphaMode, ChannelRef, Material, MaterialTextures, Pbr, f0_of_ior};
 pub use mesh::Mesh;
-pub use texture::{ColorSpace, Filter, Texture, TextureRef, Wrap, srgb_to_linear};
+pub use texture::{ColorSpace, Filter, Texture, TextureRef, Wrap, linear_to_srgb, srgb_to_linear};
 
 use glam::{Affine3A, Vec3};
 

@@ -184,6 +184,16 @@ fn srgb_table() -> &'static [f32] {
     })
 }
 
+/// The sRGB encoding of a linear value (IEC 61966-2-1), clamped to [0, 1].
+pub fn linear_to_srgb(x: f32) -> f32 {
+    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        (1.055 * x.powf(1.0 / 2.4) - 0.055).min(1.0)
+    }
+}
+
 /// The sRGB electro-optical transfer function (IEC 61966-2-1).
 pub fn srgb_to_linear(v: f32) -> f32 {
     if v <= 0.04045 {

@@ -4,6 +4,7 @@ use glam::{Affine2, Vec2, Vec3, Vec4};
 
 use super::files::{image_bytes, is_data_uri};
 use super::{GltfLoader, MAX_UV_SETS, spec_gloss, texture_transform};
+use crate::limits::check_memory;
 use crate::load::images::decode_texture;
 use crate::scene::{
     AlphaMode, ChannelRef, Filter, Material, MaterialTextures, Pbr, TextureRef, Wrap,
@@ -122,19 +123,24 @@ impl GltfLoader {
             );
         }
         if let Some(sg) = material.extension_value(spec_gloss::EXTENSION) {
-            // It replaces pbrMetallicRoughness; its diffuse texture multiplies the converted
-            // base colour (exact while the conversion finds no metal, as for F0 = 0.04).
+            // It replaces pbrMetallicRoughness (the extension's specification).
             let [dr, dg, db, da] = json_vec4(&sg["diffuseFactor"], [1.0; 4]);
-            let m = spec_gloss::convert(
+            let factors = (
                 Vec4::new(dr, dg, db, da),
                 json_vec3(&sg["specularFactor"], Vec3::ONE),
                 json_f32(&sg["glossinessFactor"], 1.0),
             );
+            let m = spec_gloss::convert(factors.0, factors.1, factors.2);
             (pbr.base_colour, pbr.metallic, pbr.roughness, alpha) =
                 (m.base_colour, m.metallic, m.roughness, m.alpha);
-            textures.base_colour = self.json_texture(document, &sg["diffuseTexture"], &name);
+            let diffuse = self.json_texture(document, &sg["diffuseTexture"], &name);
+            let spec_gloss_texture =
+                self.json_texture(document, &sg["specularGlossinessTexture"], &name);
+            textures.base_colour = diffuse;
             (textures.metallic, textures.roughness) = (None, None);
-            self.warn_unread_textures(&name, sg, &["specularGlossinessTexture"]);
+            if let Some(sg_ref) = spec_gloss_texture {
+                self.bake_spec_gloss(&name, diffuse, sg_ref, factors, &mut pbr, &mut textures);
+            }
         }
         let alpha_mode = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
@@ -197,6 +203,64 @@ impl GltfLoader {
             json_texture_transform(t, &mut r);
         }
         Some(r)
+    }
+
+    /// A specular–glossiness texture (and the diffuse texture beside it) baked into base
+    /// colour and metallic–roughness textures that carry the whole material, the factors
+    /// included. With the diffuse texture on other coordinates the two cannot be baked
+    /// together: the specular–glossiness texture is then left out, with a warning, and the
+    /// factors and diffuse texture stand (a diffuse texture alone multiplies the converted
+    /// base colour, exact while the conversion finds no metal, as for F0 = 0.04).
+    fn bake_spec_gloss(
+        &mut self,
+        name: &str,
+        diffuse: Option<TextureRef>,
+        sg_ref: TextureRef,
+        factors: (Vec4, Vec3, f32),
+        pbr: &mut Pbr,
+        textures: &mut MaterialTextures,
+    ) {
+        let same_place =
+            |d: &TextureRef| d.texcoord == sg_ref.texcoord && d.transform == sg_ref.transform;
+        if !diffuse.as_ref().is_none_or(same_place) {
+            self.warn(format!(
+                "material '{name}': its diffuse and specular-glossiness textures use different coordinates; the specular-glossiness texture is not read"
+            ));
+            return;
+        }
+        let spec_gloss_texture = self.builder.texture(sg_ref.texture);
+        let diffuse_texture = diffuse.map(|d| self.builder.texture(d.texture));
+        let texels = u64::from(
+            diffuse_texture
+                .map_or(0, |d| d.width)
+                .max(spec_gloss_texture.width),
+        ) * u64::from(
+            diffuse_texture
+                .map_or(0, |d| d.height)
+                .max(spec_gloss_texture.height),
+        );
+        if let Err(e) = check_memory(|| format!("material '{name}'"), texels.saturating_mul(16)) {
+            self.warn(format!("{e}; the specular-glossiness texture is not read"));
+            return;
+        }
+        let (base, metal_rough) =
+            spec_gloss::bake(diffuse_texture, spec_gloss_texture, factors, name);
+        let base = self.builder.add_texture(base);
+        let metal_rough = self.builder.add_texture(metal_rough);
+        (pbr.base_colour, pbr.metallic, pbr.roughness) = (Vec3::ONE, 1.0, 1.0);
+        let place = diffuse.unwrap_or(sg_ref);
+        textures.base_colour = Some(TextureRef {
+            texture: base,
+            ..place
+        });
+        let channel = |channel| ChannelRef {
+            texture: TextureRef {
+                texture: metal_rough,
+                ..place
+            },
+            channel,
+        };
+        (textures.metallic, textures.roughness) = (Some(channel(2)), Some(channel(1)));
     }
 
     /// Extension textures gridtrace does not read yet get one warning each.

@@ -3,9 +3,11 @@
 //! extension ("convert between workflows"): the metalness that reproduces the diffuse and
 //! specular brightness (perceived as √(0.299 r² + 0.587 g² + 0.114 b²)) given a dielectric
 //! F0 of 0.04, a base colour blended from the diffuse and specular colours by metalness²,
-//! and roughness = 1 − glossiness.
+//! and roughness = 1 − glossiness; with textures, the same conversion texel by texel.
 
 use glam::{Vec3, Vec4};
+
+use crate::scene::{Texture, linear_to_srgb, srgb_to_linear};
 
 /// The extension's name.
 pub const EXTENSION: &str = "KHR_materials_pbrSpecularGlossiness";
@@ -64,6 +66,59 @@ fn solve_metallic(diffuse: f32, specular: f32, one_minus_specular: f32) -> f32 {
     let c = DIELECTRIC_F0 - specular;
     let discriminant = (b * b - 4.0 * a * c).max(0.0);
     ((-b + discriminant.sqrt()) / (2.0 * a)).clamp(0.0, 1.0)
+}
+
+/// A specular–glossiness texture pair baked texel by texel into a base colour texture
+/// (sRGB, alpha from the diffuse texture) and a metallic–roughness texture (G roughness,
+/// B metallic, linear), with the factors folded in, at the finer of the two resolutions
+/// (each read at its texel nearest the same position).
+pub(super) fn bake(
+    diffuse: Option<&Texture>,
+    spec_gloss: &Texture,
+    factors: (Vec4, Vec3, f32),
+    name: &str,
+) -> (Texture, Texture) {
+    let (diffuse_factor, specular_factor, glossiness_factor) = factors;
+    let width = diffuse.map_or(0, |d| d.width).max(spec_gloss.width);
+    let height = diffuse.map_or(0, |d| d.height).max(spec_gloss.height);
+    // Texel (x, y) of the baked image in texture `t`.
+    let at = |t: &Texture, x: u32, y: u32| {
+        let tx = (u64::from(x) * u64::from(t.width) / u64::from(width)) as u32;
+        let ty = (u64::from(y) * u64::from(t.height) / u64::from(height)) as u32;
+        t.texels[(ty * t.width + tx) as usize]
+    };
+    let unit = |c: u16| f32::from(c) / 65535.0;
+    let encode = |v: f32| (v.clamp(0.0, 1.0) * 65535.0).round() as u16;
+    let mut base = Vec::with_capacity((width * height) as usize);
+    let mut metal_rough = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let sg = at(spec_gloss, x, y);
+            let d = diffuse.map_or([65535; 4], |t| at(t, x, y));
+            let linear = |c: u16| srgb_to_linear(unit(c));
+            let diffuse = Vec4::new(linear(d[0]), linear(d[1]), linear(d[2]), 1.0)
+                * diffuse_factor.with_w(1.0);
+            let specular = Vec3::new(linear(sg[0]), linear(sg[1]), linear(sg[2])) * specular_factor;
+            let m = convert(diffuse, specular, unit(sg[3]) * glossiness_factor);
+            base.push([
+                encode(linear_to_srgb(m.base_colour.x)),
+                encode(linear_to_srgb(m.base_colour.y)),
+                encode(linear_to_srgb(m.base_colour.z)),
+                d[3],
+            ]);
+            metal_rough.push([0, encode(m.roughness), encode(m.metallic), 65535]);
+        }
+    }
+    let texture = |suffix: &str, texels| Texture {
+        name: format!("{name} ({suffix}, from specular-glossiness)"),
+        width,
+        height,
+        texels,
+    };
+    (
+        texture("base colour", base),
+        texture("metallic-roughness", metal_rough),
+    )
 }
 
 #[cfg(test)]
