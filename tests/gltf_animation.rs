@@ -8,6 +8,7 @@
 //! reference-image criteria).
 
 mod image_stats;
+mod world;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -16,6 +17,7 @@ use glam::Vec3;
 use gridtrace::load::{LoadOptions, load_scene_with};
 use gridtrace::scene::Scene;
 use image_stats::{check_agreement, render_scene_halves};
+use world::{corners, farthest, world_triangles};
 
 const FRAMES: [u32; 4] = [1, 7, 13, 24];
 
@@ -35,31 +37,7 @@ fn load_at(path: &Path, frame: Option<f64>, animation: Option<&str>) -> (Scene, 
 
 /// Every triangle corner in world space.
 fn world_corners(scene: &Scene) -> Vec<Vec3> {
-    scene
-        .instances
-        .iter()
-        .flat_map(|instance| {
-            let mesh = &scene.meshes[instance.mesh];
-            mesh.indices.iter().flat_map(move |t| {
-                t.map(|v| {
-                    instance
-                        .world_from_object
-                        .transform_point3(mesh.positions[v as usize])
-                })
-            })
-        })
-        .collect()
-}
-
-/// The largest distance from a corner of `a` to the nearest corner of `b`.
-fn farthest(a: &[Vec3], b: &[Vec3]) -> f32 {
-    a.iter()
-        .map(|p| {
-            b.iter()
-                .map(|q| p.distance(*q))
-                .fold(f32::INFINITY, f32::min)
-        })
-        .fold(0.0, f32::max)
+    corners(&world_triangles(scene))
 }
 
 fn posed_error(ours: &Scene, blender: &Scene) -> f32 {

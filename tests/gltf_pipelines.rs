@@ -24,14 +24,15 @@
 //! The tools come from `tools/setup-dev.sh` (`npm ci` in `tools/npm`).
 
 mod image_stats;
+mod world;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use glam::Vec3;
 use gridtrace::load::load_scene;
 use gridtrace::scene::Scene;
 use image_stats::{check_agreement, check_image_means, render_halves, scene_path};
+use world::{corners, farthest, world_triangles};
 
 /// Samples per pixel of the noise-aware comparisons (two halves).
 const SPP: u32 = 64;
@@ -93,41 +94,6 @@ fn load(path: &Path) -> Scene {
     let loaded = load_scene(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
     loaded.scene
-}
-
-/// Every triangle in world space, corners in file order, triangles sorted.
-fn world_triangles(scene: &Scene) -> Vec<[[f32; 3]; 3]> {
-    let mut triangles: Vec<[[f32; 3]; 3]> = scene
-        .instances
-        .iter()
-        .flat_map(|instance| {
-            let mesh = &scene.meshes[instance.mesh];
-            mesh.indices.iter().map(move |t| {
-                t.map(|v| {
-                    instance
-                        .world_from_object
-                        .transform_point3(mesh.positions[v as usize])
-                        .to_array()
-                })
-            })
-        })
-        .collect();
-    triangles.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    triangles
-}
-
-/// The largest distance from a corner of `a` to the nearest corner of `b`.
-fn farthest_corner(a: &[[[f32; 3]; 3]], b: &[[[f32; 3]; 3]]) -> f32 {
-    let corners =
-        |t: &[[[f32; 3]; 3]]| -> Vec<Vec3> { t.iter().flatten().map(|&p| Vec3::from(p)).collect() };
-    let (a, b) = (corners(a), corners(b));
-    a.iter()
-        .map(|p| {
-            b.iter()
-                .map(|q| p.distance(*q))
-                .fold(f32::INFINITY, f32::min)
-        })
-        .fold(0.0, f32::max)
 }
 
 fn render_agrees(what: &str, path: &Path) {
@@ -203,7 +169,8 @@ fn quantised_geometry_is_within_one_quantisation_step() {
         let rewritten = load(&path);
         let (a, b) = (world_triangles(&original), world_triangles(&rewritten));
         assert_eq!(a.len(), b.len(), "{name}: triangle count");
-        let error = farthest_corner(&a, &b).max(farthest_corner(&b, &a));
+        let (a, b) = (corners(&a), corners(&b));
+        let error = farthest(&a, &b).max(farthest(&b, &a));
         println!("{name}: farthest vertex {error:.2e} (limit {step:.2e})");
         assert!(error <= step, "{name}: a vertex moved {error}, over {step}");
         render_agrees(name, &path);

@@ -695,7 +695,7 @@ fn references_and_instances_are_composed() {
 /// The scene at `frame` (`None`: the stage's start), which must load without warnings.
 fn scene_at_frame(path: &Path, frame: Option<f64>) -> Scene {
     let options = LoadOptions {
-        frame: frame,
+        frame,
         ..LoadOptions::default()
     };
     let loaded = load_scene_with(path, &options).unwrap();

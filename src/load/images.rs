@@ -89,9 +89,15 @@ fn check_ktx2_header(bytes: &[u8]) -> Result<(), String> {
     };
     // The transcoder allocates by the image's size before decoding anything; so do we
     // (its 8-bit output and our 16-bit copy).
-    let texels = width.saturating_mul(height).saturating_mul(layers).saturating_mul(faces);
-    check_memory(|| format!("a {width}×{height} KTX2 image"), texels.saturating_mul(12))
-        .map_err(|e| e.to_string())?;
+    let texels = width
+        .saturating_mul(height)
+        .saturating_mul(layers)
+        .saturating_mul(faces);
+    check_memory(
+        || format!("a {width}×{height} KTX2 image"),
+        texels.saturating_mul(12),
+    )
+    .map_err(|e| e.to_string())?;
     const ZSTANDARD: u64 = 2;
     if scheme != ZSTANDARD {
         return Ok(());

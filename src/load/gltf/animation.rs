@@ -110,7 +110,9 @@ fn evaluate_one(
                 output.values.len()
             )));
         }
-        if input.values.windows(2).any(|w| !(w[0] < w[1])) {
+        // Strictly increasing and finite (a NaN compares as not increasing).
+        let increasing = |w: &[f32]| w[0].partial_cmp(&w[1]) == Some(std::cmp::Ordering::Less);
+        if !input.values.windows(2).all(increasing) || !input.values.iter().all(|t| t.is_finite()) {
             return Err(what("key times do not increase".into()));
         }
         let slerp = property == Property::Rotation;
