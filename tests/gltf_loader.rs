@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{quad_document, write_gltf};
+use common::{quad_document, write_gltf, write_unchecked_gltf};
 use glam::{Affine3A, Quat, Vec3};
 use gridtrace::cli::choose_camera;
 use gridtrace::load::{GltfLightUnits, LoadError, LoadOptions, load_scene, load_scene_with};
@@ -281,7 +281,7 @@ fn broken_files_give_one_clear_error_naming_the_file() {
 
     let mut doc = quad_document();
     doc["accessors"][1]["count"] = json!(600);
-    let err = load_scene(&write_gltf(dir.path(), "past.gltf", &doc))
+    let err = load_scene(&write_unchecked_gltf(dir.path(), "past.gltf", &doc))
         .unwrap_err()
         .to_string();
     assert!(
@@ -291,7 +291,7 @@ fn broken_files_give_one_clear_error_naming_the_file() {
 
     let mut doc = quad_document();
     doc["meshes"][0]["primitives"][0]["material"] = json!(9);
-    let err = load_scene(&write_gltf(dir.path(), "idx.gltf", &doc))
+    let err = load_scene(&write_unchecked_gltf(dir.path(), "idx.gltf", &doc))
         .unwrap_err()
         .to_string();
     assert!(
@@ -467,7 +467,7 @@ fn bad_punctual_lights_are_skipped_with_a_warning() {
     ]}});
     doc["nodes"] = json!([{"mesh": 0}, {"extensions": {"KHR_lights_punctual": {"light": 0}}}]);
     doc["scenes"] = json!([{"nodes": [0, 1]}]);
-    let loaded = load_scene(&write_gltf(dir.path(), "bad_light.gltf", &doc)).unwrap();
+    let loaded = load_scene(&write_unchecked_gltf(dir.path(), "bad_light.gltf", &doc)).unwrap();
     assert!(loaded.scene.lights.is_empty());
     assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
     assert!(
@@ -530,7 +530,7 @@ fn the_files_beside_a_gltf_are_listed() {
     // An image that exists and one that does not (the latter only warns).
     std::fs::write(dir.path().join("wood.png"), b"not decoded here").unwrap();
     document["images"] = serde_json::json!([{"uri": "wood.png"}, {"uri": "gone%20missing.png"}]);
-    let path = common::write_gltf(dir.path(), "scene.gltf", &document);
+    let path = write_unchecked_gltf(dir.path(), "scene.gltf", &document);
     let loaded = load_scene(&path).unwrap();
     let names: Vec<_> = loaded
         .files
@@ -561,7 +561,7 @@ fn principled_extensions_are_read() {
          }}
     ]);
     doc["meshes"][0]["primitives"][0]["material"] = json!(0);
-    let loaded = load_scene(&write_gltf(dir.path(), "p.gltf", &doc)).unwrap();
+    let loaded = load_scene(&write_unchecked_gltf(dir.path(), "p.gltf", &doc)).unwrap();
     assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
     assert!(
         loaded.warnings[0].contains("texture 0 does not exist"),

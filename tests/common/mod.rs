@@ -52,8 +52,27 @@ pub fn quad_buffer() -> Vec<u8> {
     bytes
 }
 
-/// Writes `document` as `name` (and the quad buffer beside it) into `dir`.
+/// Writes `document` as `name` (and the quad buffer beside it) into `dir`, and checks it
+/// with Khronos' glTF-Validator (`tools/npm`, installed by `tools/setup-dev.sh`).
 pub fn write_gltf(dir: &Path, name: &str, document: &Value) -> PathBuf {
+    let path = write_unchecked_gltf(dir, name, document);
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/npm/validate.mjs");
+    let out = std::process::Command::new("node")
+        .arg(validator)
+        .arg(&path)
+        .output()
+        .expect("node runs (tools/setup-dev.sh)");
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    path
+}
+
+/// [`write_gltf`] for a document that breaks the specification on purpose.
+pub fn write_unchecked_gltf(dir: &Path, name: &str, document: &Value) -> PathBuf {
     std::fs::write(dir.join("quad.bin"), quad_buffer()).unwrap();
     let path = dir.join(name);
     std::fs::write(&path, serde_json::to_vec_pretty(document).unwrap()).unwrap();
