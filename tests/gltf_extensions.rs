@@ -14,14 +14,8 @@ use serde_json::{Value, json};
 
 /// Writes `document` with `buffer` as its only buffer, in a base64 data URI, and checks it
 /// with Khronos' glTF-Validator (`tools/npm`, installed by `tools/setup-dev.sh`).
-fn write(dir: &Path, name: &str, buffer: &[u8], mut document: Value) -> PathBuf {
-    document["asset"] = json!({"version": "2.0"});
-    document["buffers"] = json!([{
-        "uri": format!("data:application/octet-stream;base64,{}", base64::encode(buffer)),
-        "byteLength": buffer.len()
-    }]);
-    let path = dir.join(name);
-    std::fs::write(&path, serde_json::to_vec_pretty(&document).unwrap()).unwrap();
+fn write(dir: &Path, name: &str, buffer: &[u8], document: Value) -> PathBuf {
+    let path = write_unchecked(dir, name, buffer, document);
     let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/npm/validate.mjs");
     let out = std::process::Command::new("node")
         .arg(validator)
@@ -34,6 +28,18 @@ fn write(dir: &Path, name: &str, buffer: &[u8], mut document: Value) -> PathBuf 
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
+    path
+}
+
+/// [`write`] without the validator, for a file that breaks the specification on purpose.
+fn write_unchecked(dir: &Path, name: &str, buffer: &[u8], mut document: Value) -> PathBuf {
+    document["asset"] = json!({"version": "2.0"});
+    document["buffers"] = json!([{
+        "uri": format!("data:application/octet-stream;base64,{}", base64::encode(buffer)),
+        "byteLength": buffer.len()
+    }]);
+    let path = dir.join(name);
+    std::fs::write(&path, serde_json::to_vec_pretty(&document).unwrap()).unwrap();
     path
 }
 
@@ -325,4 +331,35 @@ fn specular_glossiness_textures_are_baked_texel_by_texel() {
         );
     }
     assert_eq!(base.texels[1][3], 128 * 257);
+}
+
+/// A morphed node reached through two parents (which the specification forbids, and a
+/// hostile file may do a million times) is posed once and drawn twice.
+#[test]
+fn a_posed_node_reached_twice_is_posed_once() {
+    let (mut buffer, mut document) = quad_facing_camera(json!({}), "KHR_materials_unlit");
+    let offset = buffer.len();
+    buffer.extend(f32s(&[0.0, 0.0, 1.0].repeat(4)));
+    document["bufferViews"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 48}));
+    document["accessors"].as_array_mut().unwrap().push(
+        json!({"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3",
+               "min": [0, 0, 1], "max": [0, 0, 1]}),
+    );
+    document["meshes"][0]["primitives"][0]["targets"] = json!([{"POSITION": 2}]);
+    document["meshes"][0]["weights"] = json!([0.5]);
+    document["nodes"] = json!([
+        {"children": [2], "translation": [-3, 0, 0]},
+        {"children": [2], "translation": [3, 0, 0]},
+        {"mesh": 0}
+    ]);
+    document["scenes"] = json!([{"nodes": [0, 1]}]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = write_unchecked(dir.path(), "shared.gltf", &buffer, document);
+    let scene = load_scene(&path).unwrap().scene;
+    assert_eq!(scene.instances.len(), 2);
+    assert_eq!(scene.meshes.len(), 1);
+    assert!(scene.meshes[0].positions.iter().all(|p| p.z == 0.5));
 }

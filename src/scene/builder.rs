@@ -90,6 +90,11 @@ impl SceneBuilder {
         &mut self.scene.materials[index]
     }
 
+    /// A mesh added before.
+    pub fn mesh(&self, index: usize) -> &Mesh {
+        &self.scene.meshes[index]
+    }
+
     /// A texture added before.
     pub fn texture(&self, index: usize) -> &Texture {
         &self.scene.textures[index]

@@ -109,6 +109,8 @@ pub fn load_bytes_with(
         missing_images: HashSet::new(),
         normal_mapped: Vec::new(),
         coloured_materials: HashSet::new(),
+        posed: HashMap::new(),
+        posed_bytes: 0,
         time: options
             .frame
             .map(|frame| (frame / options.frames_per_second()) as f32),
@@ -268,6 +270,11 @@ struct GltfLoader {
     /// Scene materials (glTF materials and the default one) used by a primitive with vertex
     /// colours.
     coloured_materials: HashSet<usize>,
+    /// Our meshes for each posed (skinned or morphed) node, made on its first visit.
+    posed: HashMap<usize, Vec<usize>>,
+    /// Bytes of vertex data in posed copies so far, held to the memory budget: a few bytes
+    /// of JSON may name a large skinned mesh from many nodes.
+    posed_bytes: u64,
     /// The time (seconds) to pose animated nodes at; `None`: as stored.
     time: Option<f32>,
     /// The animation asked for by name or index (`None`: the first).

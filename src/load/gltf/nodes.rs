@@ -10,6 +10,7 @@ use glam::{Affine3A, Mat4, Quat, Vec3};
 use super::animation::{self, Pose};
 use super::deform::Deformation;
 use super::{GltfLoader, MAX_NODE_DEPTH, MAX_NODE_VISITS, instancing};
+use crate::limits::check_memory;
 use crate::load::LoadError;
 
 /// A node with a mesh, found while walking the hierarchy.
@@ -129,8 +130,14 @@ impl GltfLoader {
         };
         let ours = if deformation.is_rest() {
             self.meshes_of(document, &mesh)?
+        } else if let Some(ours) = self.posed.get(&node.index()) {
+            // The same node reached again through a shared parent has the same pose.
+            ours.clone()
         } else {
-            self.posed_meshes(document, &mesh, deformation)?
+            let ours = self.posed_meshes(document, &mesh, deformation)?;
+            self.posed.insert(node.index(), ours.clone());
+            self.account_for_posed(&ours, source)?;
+            ours
         };
         // A skinned mesh is placed by its joints alone (glTF 2.0 §3.7.3.3).
         let world = if joints.is_some() {
@@ -159,6 +166,19 @@ impl GltfLoader {
             }
         }
         Ok(())
+    }
+
+    /// Adds posed meshes to the running total of posed vertex data, refusing the scene once
+    /// it passes the memory budget.
+    fn account_for_posed(&mut self, ours: &[usize], source: &str) -> Result<(), LoadError> {
+        for &m in ours {
+            let mesh = self.builder.mesh(m);
+            let vertex = std::mem::size_of::<Vec3>() * 2 + std::mem::size_of::<glam::Vec4>() * 2;
+            let bytes = mesh.positions.len() * vertex + mesh.indices.len() * 12;
+            self.posed_bytes = self.posed_bytes.saturating_add(bytes as u64);
+        }
+        check_memory(|| format!("{source}: posed meshes"), self.posed_bytes)
+            .map_err(|e| self.invalid(e.to_string()))
     }
 
     /// Each joint's world transform times its inverse bind matrix.
