@@ -4,6 +4,7 @@
 //! `KHR_materials_pbrSpecularGlossiness`.
 
 mod binary;
+mod common;
 mod image_stats;
 
 use std::path::{Path, PathBuf};
@@ -16,18 +17,7 @@ use serde_json::{Value, json};
 /// with Khronos' glTF-Validator (`tools/npm`, installed by `tools/setup-dev.sh`).
 fn write(dir: &Path, name: &str, buffer: &[u8], document: Value) -> PathBuf {
     let path = write_unchecked(dir, name, buffer, document);
-    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/npm/validate.mjs");
-    let out = std::process::Command::new("node")
-        .arg(validator)
-        .arg(&path)
-        .output()
-        .expect("node runs (tools/setup-dev.sh)");
-    assert!(
-        out.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::validate_gltf(&path);
     path
 }
 

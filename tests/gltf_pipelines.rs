@@ -23,6 +23,7 @@
 //!
 //! The tools come from `tools/setup-dev.sh` (`npm ci` in `tools/npm`).
 
+mod common;
 mod image_stats;
 mod world;
 
@@ -66,7 +67,7 @@ fn transform(dir: &Path, name: &str, args: &[&str]) -> PathBuf {
             .arg(&out)
             .args(&args[1..]),
     );
-    validate(&out);
+    common::validate_gltf(&out);
     out
 }
 
@@ -79,15 +80,8 @@ fn ktx2(dir: &Path, mode: &str) -> PathBuf {
         .arg(scene_path("textured"))
         .arg(&out)
         .arg(mode));
-    validate(&out);
+    common::validate_gltf(&out);
     out
-}
-
-/// Khronos' validator finds no error.
-fn validate(path: &Path) {
-    run(Command::new("node")
-        .arg(npm_tools().join("validate.mjs"))
-        .arg(path));
 }
 
 fn load(path: &Path) -> Scene {

@@ -56,10 +56,17 @@ pub fn quad_buffer() -> Vec<u8> {
 /// with Khronos' glTF-Validator (`tools/npm`, installed by `tools/setup-dev.sh`).
 pub fn write_gltf(dir: &Path, name: &str, document: &Value) -> PathBuf {
     let path = write_unchecked_gltf(dir, name, document);
+    validate_gltf(&path);
+    path
+}
+
+/// Panics with the report unless Khronos' glTF-Validator (`tools/npm/validate.mjs`,
+/// installed by `tools/setup-dev.sh`) finds no error in the file at `path`.
+pub fn validate_gltf(path: &Path) {
     let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/npm/validate.mjs");
     let out = std::process::Command::new("node")
         .arg(validator)
-        .arg(&path)
+        .arg(path)
         .output()
         .expect("node runs (tools/setup-dev.sh)");
     assert!(
@@ -68,7 +75,6 @@ pub fn write_gltf(dir: &Path, name: &str, document: &Value) -> PathBuf {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    path
 }
 
 /// [`write_gltf`] for a document that breaks the specification on purpose.
