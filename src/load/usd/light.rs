@@ -3,8 +3,9 @@
 use glam::{Affine3A, Mat3, Mat4, Vec3};
 use openusd::sdf;
 
-use super::{DISK_SEGMENTS, UsdLoader, as_asset, as_bool, as_vec3};
-use crate::scene::{Camera, Environment, Light, LightKind, Material, Projection, ThinLens};
+use super::value::{as_asset, as_bool, as_vec3};
+use super::{DISK_SEGMENTS, UsdLoader};
+use crate::scene::{Environment, Light, LightKind, Material};
 
 impl UsdLoader {
     /// A UsdLux light's `intensity × 2^exposure × color`, tinted by its colour temperature
@@ -105,63 +106,6 @@ impl UsdLoader {
         ]
         .iter()
         .find_map(|name| self.get(prim, name).as_ref().and_then(as_bool))
-    }
-
-    pub(super) fn add_camera(&mut self, prim: &sdf::Path, world: Mat4) {
-        let where_ = prim.as_str().to_string();
-        // Apertures and focal length share a unit (tenths of a scene unit), so their ratio
-        // is the field of view; the defaults are USD's.
-        let focal = self.get_f32(prim, "focalLength").unwrap_or(50.0);
-        let horizontal = self.get_f32(prim, "horizontalAperture").unwrap_or(20.955);
-        let vertical = self.get_f32(prim, "verticalAperture").unwrap_or(15.2908);
-        let znear = match self.get(prim, "clippingRange") {
-            Some(sdf::Value::Vec2f(r)) => r.x,
-            Some(sdf::Value::Vec2d(r)) => r.x as f32,
-            _ => 1.0,
-        };
-        let (scale, rotation, translation) = world.to_scale_rotation_translation();
-        let projection = if self.get_token(prim, "projection").as_deref() == Some("orthographic") {
-            // Apertures in tenths of a scene unit, here after the stage's scale.
-            Projection::Orthographic {
-                xmag: 0.05 * horizontal * scale.x,
-                ymag: 0.05 * vertical * scale.y,
-            }
-        } else {
-            if !(focal > 0.0 && vertical > 0.0 && horizontal > 0.0) {
-                self.warn(format!(
-                    "{where_}: camera with zero focal length or aperture; skipped"
-                ));
-                return;
-            }
-            Projection::Perspective {
-                yfov: 2.0 * (0.5 * vertical / focal).atan(),
-                aspect_ratio: Some(horizontal / vertical),
-            }
-        };
-        // Depth of field: a thin lens of radius focal length / (2 × fStop), focused at
-        // focusDistance (scene units); fStop 0, USD's default, is a pinhole.
-        let focal_length = 0.1 * focal * scale.y;
-        let f_stop = self.get_f32(prim, "fStop").unwrap_or(0.0);
-        let focus = self.get_f32(prim, "focusDistance").unwrap_or(0.0) * scale.y;
-        let lens =
-            (f_stop > 0.0 && focus > 0.0 && f_stop.is_finite() && focus.is_finite()).then(|| {
-                ThinLens {
-                    radius: focal_length / (2.0 * f_stop),
-                    focus_distance: focus,
-                }
-            });
-        self.builder.add_camera(Camera {
-            name: where_.clone(),
-            world_from_camera: Affine3A::from_rotation_translation(
-                rotation.normalize(),
-                translation,
-            ),
-            projection,
-            znear: znear * scale.y,
-            lens,
-            focal_length: (focal_length > 0.0).then_some(focal_length),
-            source: where_,
-        });
     }
 
     /// UsdLux lights. Rect and disk lights are emitting surfaces, a sphere with a radius a

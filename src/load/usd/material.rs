@@ -5,7 +5,8 @@ use std::path::Path;
 use glam::{Affine2, Vec2, Vec3};
 use openusd::sdf;
 
-use super::{UsdLoader, as_vec3};
+use super::UsdLoader;
+use super::value::as_vec3;
 use crate::limits::memory_budget;
 use crate::load::access::read_regular_file;
 use crate::load::images::{decode_environment, decode_texture};
