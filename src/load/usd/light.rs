@@ -3,7 +3,7 @@
 use glam::{Affine3A, Mat3, Mat4, Vec3};
 use openusd::sdf;
 
-use super::value::{as_asset, as_bool, as_vec3};
+use super::value::{as_bool, as_vec3};
 use super::{DISK_SEGMENTS, UsdLoader};
 use crate::scene::{Environment, Light, LightKind, Material};
 
@@ -48,10 +48,10 @@ impl UsdLoader {
             ));
             return;
         }
-        let file = self
-            .get(prim, "inputs:texture:file")
-            .as_ref()
-            .and_then(as_asset);
+        let file = match self.get(prim, "inputs:texture:file") {
+            Some(sdf::Value::AssetPath(a)) => Some(a),
+            _ => None,
+        };
         let Some(file) = file.filter(|f| !f.is_empty()) else {
             if !self.builder.add_environment(tint) {
                 self.warn(format!(

@@ -6,9 +6,8 @@ use glam::{Affine2, Vec2, Vec3};
 use openusd::sdf;
 
 use super::UsdLoader;
-use super::value::as_vec3;
-use crate::limits::memory_budget;
-use crate::load::access::read_regular_file;
+use super::value::{as_f64, as_token, as_vec3};
+use super::resolver::{package_file, read_asset};
 use crate::load::images::{decode_environment, decode_texture};
 use crate::scene::{
     AlphaMode, ChannelRef, ColorSpace, EnvironmentMap, Material, MaterialTextures, Pbr, TextureRef,
@@ -36,24 +35,18 @@ impl UsdLoader {
         variant
     }
 
-    /// The material bound to `prim` (`material:binding`), converted once per material.
-    pub(super) fn bound_material(&mut self, prim: &sdf::Path) -> usize {
-        let target = prim
-            .append_property("material:binding")
-            .ok()
-            .and_then(|rel| self.stage.relationship(rel).targets().ok())
-            .and_then(|t| t.into_iter().next());
-        let Some(target) = target else {
-            return self.default_material();
-        };
+    /// The material bound to `prim` ([`UsdLoader::compute_bound_material`]), converted once
+    /// per material; `None` when nothing is bound.
+    pub(super) fn bound_material(&mut self, prim: &sdf::Path) -> Option<usize> {
+        let target = self.compute_bound_material(prim)?;
         let key = target.as_str().to_string();
         if let Some(&m) = self.materials.get(&key) {
-            return m;
+            return Some(m);
         }
         let material = self.convert_material(&target);
         let index = self.builder.add_material(material);
         self.materials.insert(key, index);
-        index
+        Some(index)
     }
 
     pub(super) fn default_material(&mut self) -> usize {
@@ -68,7 +61,7 @@ impl UsdLoader {
     /// A `UsdPreviewSurface` material, mapped as glTF's are.
     pub(super) fn convert_material(&mut self, material: &sdf::Path) -> Material {
         let name = material.as_str().to_string();
-        let surface = self.connected_prim(material, "outputs:surface");
+        let surface = self.compute_surface_source(material);
         let Some(shader) = surface else {
             self.warn(format!(
                 "{name}: material has no surface shader; using grey plastic"
@@ -109,7 +102,7 @@ impl UsdLoader {
             textures.normal = Some(r);
         }
         let mut alpha_mode = AlphaMode::Opaque;
-        let mut opacity = self.get_f32(&shader, "inputs:opacity").unwrap_or(1.0);
+        let mut opacity = self.input_f32(&shader, "inputs:opacity").unwrap_or(1.0);
         if let Some((r, _)) =
             self.texture_input(&shader, "inputs:opacity", ColorSpace::Linear, &name)
         {
@@ -118,7 +111,7 @@ impl UsdLoader {
             if textures.base_colour.is_none_or(|b| b.texture == r.texture) {
                 textures.base_colour.get_or_insert(r);
                 let threshold = self
-                    .get_f32(&shader, "inputs:opacityThreshold")
+                    .input_f32(&shader, "inputs:opacityThreshold")
                     .unwrap_or(0.0);
                 alpha_mode = if threshold > 0.0 {
                     AlphaMode::Mask { cutoff: threshold }
@@ -156,14 +149,14 @@ impl UsdLoader {
             transmission: (1.0 - opacity).clamp(0.0, 1.0),
             ..Pbr::default()
         };
-        if self.get_f32(&shader, "inputs:useSpecularWorkflow") == Some(1.0) {
+        if self.input_f32(&shader, "inputs:useSpecularWorkflow") == Some(1.0) {
             // The specular workflow gives F0 directly and has no metals.
             self.warn_if_connected(&shader, "inputs:specularColor", &name);
             let specular = self.constant_colour(&shader, "inputs:specularColor", Vec3::ZERO);
             pbr.metallic = 0.0;
             textures.metallic = None;
             pbr.specular_colour = specular / f0_of_ior(ior).max(1e-4);
-        } else if let Some(level) = self.get_f32(&shader, "inputs:specular") {
+        } else if let Some(level) = self.input_f32(&shader, "inputs:specular") {
             // Blender writes its "Specular IOR Level" here (not a UsdPreviewSurface input):
             // 0.5 is the plain F0 of the ior, and the level scales F0 by 2·level.
             let scale = (2.0 * level).max(0.0);
@@ -201,7 +194,7 @@ impl UsdLoader {
                 self.texture_input(shader, input, ColorSpace::Linear, material)
         {
             let node = self.connected_prim(shader, input);
-            let factor = match node.and_then(|n| self.get(&n, "inputs:scale")) {
+            let factor = match node.and_then(|n| self.input_value(&n, "inputs:scale")) {
                 Some(sdf::Value::Vec4f(v)) => [v.x, v.y, v.z, v.w][channel],
                 _ => 1.0,
             };
@@ -216,7 +209,7 @@ impl UsdLoader {
         input: &str,
         default: Vec3,
     ) -> Vec3 {
-        self.get(shader, input)
+        self.input_value(shader, input)
             .as_ref()
             .and_then(as_vec3)
             .unwrap_or(default)
@@ -230,7 +223,7 @@ impl UsdLoader {
         material: &str,
     ) -> f32 {
         self.warn_if_connected(shader, input, material);
-        self.get_f32(shader, input).unwrap_or(default)
+        self.input_f32(shader, input).unwrap_or(default)
     }
 
     /// The `UsdUVTexture` feeding `input`, as a texture reference and the colour factor its
@@ -251,8 +244,8 @@ impl UsdLoader {
             ));
             return None;
         }
-        let file = match self.get(&node, "inputs:file") {
-            Some(sdf::Value::AssetPath(a)) => a.authored_path.clone(),
+        let asset = match self.input_value(&node, "inputs:file") {
+            Some(sdf::Value::AssetPath(a)) => a,
             _ => {
                 self.warn(format!(
                     "{material}: {input}'s texture has no file; ignored"
@@ -260,15 +253,16 @@ impl UsdLoader {
                 return None;
             }
         };
-        let texture = self.texture_file(&file, material)?;
+        let file = asset.as_str().to_string();
+        let texture = self.texture_file(&asset, material)?;
         if matches!(space, ColorSpace::Srgb)
-            && self.get_token(&node, "inputs:sourceColorSpace").as_deref() == Some("raw")
+            && self.input_token(&node, "inputs:sourceColorSpace").as_deref() == Some("raw")
         {
             self.warn(format!(
                 "{material}: {input} reads '{file}' as raw data; treated as sRGB colour"
             ));
         }
-        let scale = match self.get(&node, "inputs:scale") {
+        let scale = match self.input_value(&node, "inputs:scale") {
             Some(sdf::Value::Vec4f(v)) => Vec3::new(v.x, v.y, v.z),
             _ => Vec3::ONE,
         };
@@ -278,24 +272,24 @@ impl UsdLoader {
             _ => Wrap::Repeat,
         };
         let mut reference = TextureRef::new(texture);
-        reference.wrap_u = wrap(self.get_token(&node, "inputs:wrapS"));
-        reference.wrap_v = wrap(self.get_token(&node, "inputs:wrapT"));
+        reference.wrap_u = wrap(self.input_token(&node, "inputs:wrapS"));
+        reference.wrap_v = wrap(self.input_token(&node, "inputs:wrapT"));
         // USD's st has v up the image, ours down: uv → st → UsdTransform2d → uv.
         let flip = Affine2::from_cols(Vec2::X, Vec2::NEG_Y, Vec2::Y);
         let st = self.connected_prim(&node, "inputs:st");
         if let Some(st) = st
             && self.get_token(&st, "info:id").as_deref() == Some("UsdTransform2d")
         {
-            let scale = match self.get(&st, "inputs:scale") {
+            let scale = match self.input_value(&st, "inputs:scale") {
                 Some(sdf::Value::Vec2f(v)) => Vec2::new(v.x, v.y),
                 _ => Vec2::ONE,
             };
-            let translation = match self.get(&st, "inputs:translation") {
+            let translation = match self.input_value(&st, "inputs:translation") {
                 Some(sdf::Value::Vec2f(v)) => Vec2::new(v.x, v.y),
                 _ => Vec2::ZERO,
             };
             let rotation = self
-                .get_f32(&st, "inputs:rotation")
+                .input_f32(&st, "inputs:rotation")
                 .unwrap_or(0.0)
                 .to_radians();
             let transform = Affine2::from_scale_angle_translation(scale, rotation, translation);
@@ -309,18 +303,15 @@ impl UsdLoader {
         Some((reference, factor))
     }
 
-    /// The scene texture of an image file relative to the stage, decoded once.
-    pub(super) fn texture_file(&mut self, file: &str, material: &str) -> Option<usize> {
-        if let Some(&known) = self.textures.get(file) {
+    /// The scene texture of the image at `asset`, decoded once per resolved file.
+    pub(super) fn texture_file(&mut self, asset: &sdf::AssetPath, material: &str) -> Option<usize> {
+        let key = asset.resolved_path().unwrap_or(asset.as_str()).to_string();
+        if let Some(&known) = self.textures.get(&key) {
             return known;
         }
-        let base = self.path.parent().unwrap_or(Path::new("."));
-        let bytes = self.roots.resolve(base, file).and_then(|full| {
-            self.texture_paths.push(full.clone());
-            read_regular_file(&full, file, memory_budget())
-        });
-        let decoded = match bytes.map_err(|e| e.to_string()).and_then(|bytes| {
-            decode_texture(file.to_string(), &bytes).map_err(|e| format!("'{file}' {e}"))
+        let file = asset.as_str().to_string();
+        let decoded = match self.read_asset(asset).and_then(|bytes| {
+            decode_texture(file.clone(), &bytes).map_err(|e| format!("'{file}' {e}"))
         }) {
             Ok(texture) => Some(self.builder.add_texture(texture)),
             Err(why) => {
@@ -330,25 +321,20 @@ impl UsdLoader {
                 None
             }
         };
-        self.textures.insert(file.to_string(), decoded);
+        self.textures.insert(key, decoded);
         decoded
     }
 
-    /// The environment map in image file `file` relative to the stage, or `None` with a
-    /// warning naming `prim`.
-    pub(super) fn environment_file(&mut self, file: &str, prim: &str) -> Option<EnvironmentMap> {
-        let base = self.path.parent().unwrap_or(Path::new("."));
-        let map = self
-            .roots
-            .resolve(base, file)
-            .and_then(|full| {
-                self.texture_paths.push(full.clone());
-                read_regular_file(&full, file, memory_budget())
-            })
-            .map_err(|e| e.to_string())
-            .and_then(|bytes| {
-                decode_environment(file.to_string(), &bytes).map_err(|e| format!("'{file}' {e}"))
-            });
+    /// The environment map in the image at `asset`, or `None` with a warning naming `prim`.
+    pub(super) fn environment_file(
+        &mut self,
+        asset: &sdf::AssetPath,
+        prim: &str,
+    ) -> Option<EnvironmentMap> {
+        let file = asset.as_str().to_string();
+        let map = self.read_asset(asset).and_then(|bytes| {
+            decode_environment(file.clone(), &bytes).map_err(|e| format!("'{file}' {e}"))
+        });
         match map {
             Ok(map) => Some(map),
             Err(why) => {
@@ -360,23 +346,34 @@ impl UsdLoader {
         }
     }
 
-    /// The name of the output (`outputs:r`, …) that feeds `property` of `prim`, if any.
-    pub(super) fn connected_output(&self, prim: &sdf::Path, property: &str) -> Option<String> {
-        let attribute = self.stage.attribute(prim.append_property(property).ok()?);
-        let source = attribute.connections().ok()?.into_iter().next()?;
-        let path = source.as_str();
-        Some(
-            path.rsplit_once('.')
-                .map_or(path, |(_, name)| name)
-                .to_string(),
-        )
+    /// The bytes of an asset the stage resolved against the layer that authored it (as
+    /// `SdfComputeAssetPathRelativeToLayer` anchors), from a file or from inside a `.usdz`,
+    /// through the file-access policy. The error names the authored path.
+    fn read_asset(&mut self, asset: &sdf::AssetPath) -> Result<Vec<u8>, String> {
+        let authored = asset.as_str();
+        let Some(resolved) = asset.resolved_path().filter(|r| !r.is_empty()) else {
+            return Err(format!(
+                "'{authored}' does not resolve from the layer that names it (missing, or outside the scene's folders)"
+            ));
+        };
+        let outer = package_file(resolved);
+        let file = self
+            .roots
+            .resolve(Path::new("/"), outer)
+            .map_err(|e| format!("'{authored}': {e}"))?;
+        self.texture_paths.push(file);
+        read_asset(resolved).map_err(|e| format!("'{authored}' ({resolved}): {e}"))
     }
 
-    /// The prim whose output feeds `property` of `prim` (its first connection), if any.
-    pub(super) fn connected_prim(&self, prim: &sdf::Path, property: &str) -> Option<sdf::Path> {
-        let attribute = self.stage.attribute(prim.append_property(property).ok()?);
-        let source = attribute.connections().ok()?.into_iter().next()?;
-        Some(source.prim_path())
+    fn input_f32(&self, prim: &sdf::Path, input: &str) -> Option<f32> {
+        self.input_value(prim, input)
+            .as_ref()
+            .and_then(as_f64)
+            .map(|v| v as f32)
+    }
+
+    fn input_token(&self, prim: &sdf::Path, input: &str) -> Option<String> {
+        self.input_value(prim, input).as_ref().and_then(as_token)
     }
 
     /// Networks feeding a scalar input are not read: say so.

@@ -1,4 +1,6 @@
-//! UsdGeom meshes: topology checks, triangulation, primvars and per-face materials.
+//! UsdGeom meshes: topology checks, primvars and per-face materials read into
+//! [`Polygons`], which meshes, implicit prims and refined or skinned meshes all become
+//! before they are triangulated into scene meshes ([`UsdLoader::emit`]).
 
 use std::collections::HashMap;
 
@@ -6,11 +8,45 @@ use glam::{Affine3A, Mat4, Vec2, Vec3};
 use openusd::{sdf, usd};
 
 use super::UsdLoader;
-use super::value::{Interpolation, as_bool, as_ints, as_token, as_vec2s, as_vec3s};
+use super::value::{Interpolation, as_bool, as_f64s, as_ints, as_token, as_vec2s, as_vec3s};
 use crate::load::LoadError;
 use crate::load::polygon::{MAX_EAR_CLIPPED_CORNERS, fan, triangulate};
 use crate::load::tangents::generate_tangents;
-use crate::scene::Mesh;
+use crate::scene::{AlphaMode, Material, Mesh};
+
+/// A polygon mesh as UsdGeom describes one, before triangulation.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Polygons {
+    pub points: Vec<Vec3>,
+    /// Corners of each face.
+    pub counts: Vec<usize>,
+    /// Point of each face corner, face after face.
+    pub indices: Vec<usize>,
+    pub normals: Option<(Vec<Vec3>, Interpolation)>,
+    pub uvs: Option<(Vec<Vec2>, Interpolation)>,
+    /// `primvars:displayColor` and `primvars:displayOpacity`, used where no material is bound.
+    pub display_colour: Option<(Vec<Vec3>, Interpolation)>,
+    pub display_opacity: Option<(Vec<f32>, Interpolation)>,
+    /// The bound material of each face; `None` where nothing is bound.
+    pub face_material: Vec<Option<usize>>,
+    pub left_handed: bool,
+    pub double_sided: bool,
+}
+
+/// The value a primvar gives face corner `corner` of face `face` at point `point`.
+pub(super) fn pick<T: Copy>(
+    (values, interpolation): &(Vec<T>, Interpolation),
+    corner: usize,
+    face: usize,
+    point: usize,
+) -> Option<T> {
+    match interpolation {
+        Interpolation::Constant => values.first().copied(),
+        Interpolation::Uniform => values.get(face).copied(),
+        Interpolation::Vertex => values.get(point).copied(),
+        Interpolation::FaceVarying => values.get(corner).copied(),
+    }
+}
 
 impl UsdLoader {
     /// A primvar (or the `normals` attribute) and its interpolation.
@@ -57,7 +93,8 @@ impl UsdLoader {
         Some((values, interpolation))
     }
 
-    pub(super) fn add_mesh(&mut self, prim: &usd::Prim, world: Mat4) -> Result<(), LoadError> {
+    /// Reads a `Mesh` prim into polygons; `None` for an empty mesh.
+    pub(super) fn read_mesh(&mut self, prim: &usd::Prim) -> Result<Option<Polygons>, LoadError> {
         let path = prim.path().clone();
         let where_ = path.as_str().to_string();
         let points = self
@@ -76,7 +113,7 @@ impl UsdLoader {
             .and_then(as_ints)
             .unwrap_or_default();
         if points.is_empty() || counts.is_empty() {
-            return Ok(());
+            return Ok(None);
         }
         if let Some((face, &count)) = counts.iter().enumerate().find(|(_, c)| **c < 0) {
             return Err(self.invalid(format!(
@@ -99,39 +136,57 @@ impl UsdLoader {
                 points.len()
             )));
         }
-        if let Some(scheme) = self.get_token(&path, "subdivisionScheme")
-            && scheme != "none"
-        {
-            self.warn(format!(
-                "{where_}: subdivisionScheme '{scheme}' is rendered as its control cage (no subdivision)"
-            ));
-        }
-        let left_handed = self.get_token(&path, "orientation").as_deref() == Some("leftHanded");
-        let double_sided = self
-            .get(&path, "doubleSided")
-            .as_ref()
-            .and_then(as_bool)
-            .unwrap_or(false);
-        let normals = self
-            .primvar(&path, "primvars:normals", as_vec3s, Interpolation::Vertex)
-            .or_else(|| self.primvar(&path, "normals", as_vec3s, Interpolation::Vertex));
-        let uvs = self.primvar(&path, "primvars:st", as_vec2s, Interpolation::FaceVarying);
+        let counts: Vec<usize> = counts.into_iter().map(|c| c as usize).collect();
+        let mut polygons = Polygons {
+            points,
+            indices: indices.into_iter().map(|i| i as usize).collect(),
+            left_handed: self.get_token(&path, "orientation").as_deref() == Some("leftHanded"),
+            double_sided: self
+                .get(&path, "doubleSided")
+                .as_ref()
+                .and_then(as_bool)
+                .unwrap_or(false),
+            normals: self
+                .primvar(&path, "primvars:normals", as_vec3s, Interpolation::Vertex)
+                .or_else(|| self.primvar(&path, "normals", as_vec3s, Interpolation::Vertex)),
+            uvs: self.primvar(&path, "primvars:st", as_vec2s, Interpolation::FaceVarying),
+            face_material: self.face_materials(prim, counts.len())?,
+            counts,
+            ..Polygons::default()
+        };
+        self.read_display(&path, &mut polygons);
+        Ok(Some(polygons))
+    }
 
-        // Each face's first corner (into faceVertexIndices) and corner count.
-        let mut face_start = Vec::with_capacity(counts.len());
-        let mut start = 0usize;
-        for &c in &counts {
-            face_start.push(start);
-            start += c as usize;
-        }
-        // Which material each face uses: GeomSubsets of the materialBind family override the
-        // mesh's own binding.
-        let mesh_material = self.bound_material(&path);
-        let mut face_material = vec![mesh_material; counts.len()];
-        for child in prim
+    /// `primvars:displayColor` and `primvars:displayOpacity` of any gprim.
+    pub(super) fn read_display(&self, path: &sdf::Path, polygons: &mut Polygons) {
+        polygons.display_colour = self.primvar(
+            path,
+            "primvars:displayColor",
+            as_vec3s,
+            Interpolation::Constant,
+        );
+        polygons.display_opacity = self.primvar(
+            path,
+            "primvars:displayOpacity",
+            |v| as_f64s(v).map(|a| a.into_iter().map(|x| x as f32).collect()),
+            Interpolation::Constant,
+        );
+    }
+
+    /// Which material each face uses: GeomSubsets of the `materialBind` family override
+    /// the mesh's own binding.
+    fn face_materials(
+        &mut self,
+        prim: &usd::Prim,
+        faces: usize,
+    ) -> Result<Vec<Option<usize>>, LoadError> {
+        let path = prim.path().clone();
+        let mut face_material = vec![self.bound_material(&path); faces];
+        let children = prim
             .children()
-            .map_err(|e| self.invalid(format!("{where_}: {e:#}")))?
-        {
+            .map_err(|e| self.invalid(format!("{}: {e:#}", path.as_str())))?;
+        for child in children {
             let child_path = child.path().clone();
             let is_subset = child
                 .type_name()
@@ -158,16 +213,61 @@ impl UsdLoader {
                 }
             }
         }
+        Ok(face_material)
+    }
 
-        // Triangulate each face into corners (indices into faceVertexIndices).
+    /// The material standing in where nothing is bound: white modulated by the vertex
+    /// colours `displayColor` gives, blended when `displayOpacity` is below one; grey
+    /// without either.
+    fn display_material(&mut self, polygons: &Polygons) -> usize {
+        if polygons.display_colour.is_none() && polygons.display_opacity.is_none() {
+            return self.default_material();
+        }
+        let blended = polygons
+            .display_opacity
+            .as_ref()
+            .is_some_and(|(o, _)| o.iter().any(|&o| o < 1.0));
+        let key = if blended {
+            "displayColor (blended)"
+        } else {
+            "displayColor"
+        };
+        if let Some(&m) = self.materials.get(key) {
+            return m;
+        }
+        let mut material = Material::default_grey(key);
+        material.pbr.base_colour = Vec3::ONE;
+        material.vertex_colours = true;
+        if blended {
+            material.alpha_mode = AlphaMode::Blend;
+        }
+        let m = self.builder.add_material(material);
+        self.materials.insert(key.to_string(), m);
+        m
+    }
+
+    /// Triangulates `polygons` into scene meshes, one per material, named `where_`.
+    pub(super) fn emit(&mut self, where_: &str, polygons: &Polygons) -> Vec<usize> {
+        let Polygons {
+            points,
+            counts,
+            indices,
+            normals,
+            uvs,
+            ..
+        } = polygons;
+        let display = self.display_material(polygons);
+        let mut face_start = Vec::with_capacity(counts.len());
+        let mut start = 0usize;
+        for &c in counts {
+            face_start.push(start);
+            start += c;
+        }
         let mut by_material: HashMap<usize, Vec<[usize; 3]>> = HashMap::new();
         for (face, &count) in counts.iter().enumerate() {
             let first = face_start[face];
-            let corners: Vec<usize> = (first..first + count as usize).collect();
-            let polygon: Vec<Vec3> = corners
-                .iter()
-                .map(|&c| points[indices[c] as usize])
-                .collect();
+            let corners: Vec<usize> = (first..first + count).collect();
+            let polygon: Vec<Vec3> = corners.iter().map(|&c| points[indices[c]]).collect();
             let triangles = triangulate(&polygon).unwrap_or_else(|| {
                 self.warn(format!(
                     "{where_}: face {face} is a concave polygon of {count} corners, more than \
@@ -176,65 +276,63 @@ impl UsdLoader {
                 ));
                 fan(polygon.len())
             });
+            let material = polygons.face_material[face].unwrap_or(display);
             for [a, b, c] in triangles {
                 let tri = [corners[a], corners[b], corners[c]];
-                let tri = if left_handed {
+                let tri = if polygons.left_handed {
                     [tri[0], tri[2], tri[1]]
                 } else {
                     tri
                 };
-                by_material
-                    .entry(face_material[face])
-                    .or_default()
-                    .push(tri);
+                by_material.entry(material).or_default().push(tri);
             }
         }
         let corner_face: Vec<usize> = counts
             .iter()
             .enumerate()
-            .flat_map(|(f, &c)| std::iter::repeat_n(f, c as usize))
+            .flat_map(|(f, &c)| std::iter::repeat_n(f, c))
             .collect();
-        // The value a primvar gives face corner `corner`.
-        fn pick<T: Copy>(
-            values: &[T],
-            interpolation: Interpolation,
-            corner: usize,
-            face: usize,
-            point: usize,
-        ) -> Option<T> {
-            match interpolation {
-                Interpolation::Constant => values.first().copied(),
-                Interpolation::Uniform => values.get(face).copied(),
-                Interpolation::Vertex => values.get(point).copied(),
-                Interpolation::FaceVarying => values.get(corner).copied(),
-            }
-        }
-        let transform = Affine3A::from_mat4(world);
         let mut materials: Vec<(usize, Vec<[usize; 3]>)> = by_material.into_iter().collect();
         materials.sort_by_key(|(m, _)| *m);
+        let mut meshes = Vec::new();
         for (material, triangles) in materials {
             // One vertex per triangle corner: normals and UVs may differ at every corner.
             let mut mesh = Mesh {
-                name: where_.clone(),
+                name: where_.to_string(),
                 material,
                 ..Mesh::default()
             };
             let mut normals_ok = normals.is_some();
             let mut st = Vec::new();
+            let colours = material == display
+                && (polygons.display_colour.is_some() || polygons.display_opacity.is_some());
             for (t, tri) in triangles.iter().enumerate() {
                 for &corner in tri {
-                    let (face, point) = (corner_face[corner], indices[corner] as usize);
+                    let (face, point) = (corner_face[corner], indices[corner]);
                     mesh.positions.push(points[point]);
-                    if let Some((values, interpolation)) = &normals {
-                        match pick(values, *interpolation, corner, face, point) {
+                    if let Some(normals) = normals {
+                        match pick(normals, corner, face, point) {
                             Some(n) => mesh.normals.push(n.normalize_or_zero()),
                             None => normals_ok = false,
                         }
                     }
-                    if let Some((values, interpolation)) = &uvs {
-                        let v = pick(values, *interpolation, corner, face, point);
+                    if let Some(uvs) = uvs {
+                        let v = pick(uvs, corner, face, point);
                         // USD's st has v up the image; glTF's (and ours) runs down.
                         st.push(v.map_or(Vec2::ZERO, |v| Vec2::new(v.x, 1.0 - v.y)));
+                    }
+                    if colours {
+                        let rgb = polygons
+                            .display_colour
+                            .as_ref()
+                            .and_then(|c| pick(c, corner, face, point))
+                            .unwrap_or(Vec3::ONE);
+                        let alpha = polygons
+                            .display_opacity
+                            .as_ref()
+                            .and_then(|o| pick(o, corner, face, point))
+                            .unwrap_or(1.0);
+                        mesh.colours.push(rgb.extend(alpha));
                     }
                 }
                 let base = 3 * t as u32;
@@ -246,7 +344,7 @@ impl UsdLoader {
             if !st.is_empty() {
                 mesh.uvs = vec![st];
             }
-            if !double_sided {
+            if !polygons.double_sided {
                 mesh.material = self.one_sided(material);
             }
             if self
@@ -261,9 +359,38 @@ impl UsdLoader {
                     "{where_}: a normal map needs primvars:st, which is missing; ignored here"
                 ));
             }
-            let index = self.builder.add_full_mesh(mesh);
-            self.builder.add_instance(index, transform, where_.clone());
+            meshes.push(self.builder.add_full_mesh(mesh));
         }
+        meshes
+    }
+
+    /// Puts `meshes` into the scene at `world`, or into the prototype being collected.
+    pub(super) fn place(&mut self, meshes: &[usize], world: Mat4, name: &str) {
+        for &mesh in meshes {
+            match &mut self.collecting {
+                Some(parts) => parts.push((mesh, world)),
+                None => {
+                    self.builder
+                        .add_instance(mesh, Affine3A::from_mat4(world), name.to_string());
+                }
+            }
+        }
+    }
+
+    pub(super) fn add_mesh(&mut self, prim: &usd::Prim, world: Mat4) -> Result<(), LoadError> {
+        let where_ = prim.path().as_str().to_string();
+        let Some(polygons) = self.read_mesh(prim)? else {
+            return Ok(());
+        };
+        if let Some(scheme) = self.get_token(prim.path(), "subdivisionScheme")
+            && scheme != "none"
+        {
+            self.warn(format!(
+                "{where_}: subdivisionScheme '{scheme}' is rendered as its control cage (no subdivision)"
+            ));
+        }
+        let meshes = self.emit(&where_, &polygons);
+        self.place(&meshes, world, &where_);
         Ok(())
     }
 }

@@ -18,6 +18,7 @@ mod camera;
 mod light;
 mod material;
 mod mesh;
+mod network;
 mod probe;
 mod resolver;
 mod value;
@@ -109,6 +110,8 @@ fn read_stage(path: &Path, time: Option<f64>, roots: &AssetRoots) -> Result<Load
         time,
         builder: SceneBuilder::new(),
         materials: HashMap::new(),
+        collections: HashMap::new(),
+        collecting: None,
         default_material: None,
         one_sided: HashMap::new(),
         textures: HashMap::new(),
@@ -174,6 +177,11 @@ struct UsdLoader {
     builder: SceneBuilder,
     /// Our material index for each bound USD material prim path.
     materials: HashMap<String, usize>,
+    /// Meshes and transforms relative to a PointInstancer prototype's root, while one is
+    /// being collected ([`UsdLoader::place`] puts them here instead of into the scene).
+    collecting: Option<Vec<(usize, Mat4)>>,
+    /// Collection membership, computed once per collection.
+    collections: network::Collections,
     default_material: Option<usize>,
     /// One-sided copies of materials, by the original's index.
     one_sided: HashMap<usize, usize>,
@@ -295,7 +303,13 @@ impl UsdLoader {
             let short = format!("/{}/…/{}", names[0], names[names.len() - 1]);
             return Err(self.invalid(format!("{short}: prim hierarchy deeper than {MAX_DEPTH}")));
         }
-        if !prim.is_active().unwrap_or(true) {
+        // Only defined, concrete prims are drawn: an `over` (a flattened stage's
+        // prototypes) and an abstract `class` are not, with their subtrees, as
+        // `Usd.PrimRange`'s default predicate has it.
+        if !prim.is_active().unwrap_or(true)
+            || !prim.is_defined().unwrap_or(true)
+            || prim.is_abstract().unwrap_or(false)
+        {
             return Ok(());
         }
         if self.get_token(&path, "visibility").as_deref() == Some("invisible") {

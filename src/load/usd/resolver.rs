@@ -96,11 +96,7 @@ impl Resolver for ConfinedResolver {
             self.refuse(why.to_string());
             return Err(io::Error::other(why.to_string()));
         }
-        if package_file(&name) != name {
-            return self.inner.open_asset(resolved);
-        }
-        let bytes = read_regular_file(resolved, &name, memory_budget())
-            .map_err(|e| io::Error::other(e.to_string()))?;
+        let bytes = read_asset(&name)?;
         if !bytes.starts_with(b"PXR-USDC") && !bytes.starts_with(b"PK") {
             let depth = nesting_depth(&bytes);
             if depth > MAX_TEXT_NESTING {
@@ -126,6 +122,71 @@ impl Resolver for ConfinedResolver {
     }
 }
 
+/// The bytes of a resolved asset: a regular file, or a member of a `.usdz` package
+/// (`pkg.usdz[dir/tex.png]`, packages nested in packages included), read whole but never
+/// beyond the memory budget. The caller has checked the outer file against the policy.
+pub fn read_asset(resolved: &str) -> io::Result<Vec<u8>> {
+    let budget = memory_budget();
+    let Some((package, inner)) = ar::split_package_relative_path_outer(resolved) else {
+        return read_regular_file(Path::new(resolved), resolved, budget)
+            .map_err(|e| io::Error::other(e.to_string()));
+    };
+    // Opened in place, not read whole: a package is read once per member.
+    if !std::fs::metadata(&package)?.is_file() {
+        return Err(io::Error::other(format!("{package}: not a regular file")));
+    }
+    let archive = std::fs::File::open(&package)?;
+    read_member(archive, &inner, budget, 0)
+        .map_err(|e| io::Error::other(format!("{package}: {e}")))
+}
+
+/// Deepest nesting of packages inside packages read.
+const MAX_PACKAGE_NESTING: usize = 8;
+
+/// Member `inner` (itself maybe `nested.usdz[member]`) of the zip archive in `archive`.
+/// A member's declared size is checked against `budget` before it is read, and the read is
+/// cut at the budget whatever the declaration says (the usdz specification stores members
+/// uncompressed; a compressed one could expand without bound).
+fn read_member(
+    archive: impl io::Read + io::Seek,
+    inner: &str,
+    budget: u64,
+    depth: usize,
+) -> io::Result<Vec<u8>> {
+    use std::io::Read;
+    if depth >= MAX_PACKAGE_NESTING {
+        return Err(io::Error::other(format!(
+            "packages nested more than {MAX_PACKAGE_NESTING} deep"
+        )));
+    }
+    let (member, rest) = match ar::split_package_relative_path_outer(inner) {
+        Some((member, rest)) => (member, Some(rest)),
+        None => (inner.to_string(), None),
+    };
+    let mut zip = zip::ZipArchive::new(archive)
+        .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("not a zip archive: {e}")))?;
+    let entry = zip
+        .by_name(&member)
+        .map_err(|_| io::Error::new(io::ErrorKind::NotFound, format!("no member '{member}'")))?;
+    if entry.size() > budget {
+        return Err(io::Error::other(format!(
+            "member '{member}' declares {} bytes, more than the memory budget",
+            entry.size()
+        )));
+    }
+    let mut bytes = Vec::new();
+    entry.take(budget + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > budget {
+        return Err(io::Error::other(format!(
+            "member '{member}' expands beyond the memory budget"
+        )));
+    }
+    match rest {
+        Some(rest) => read_member(io::Cursor::new(bytes), &rest, budget, depth + 1),
+        None => Ok(bytes),
+    }
+}
+
 /// True for paths that name a layer (or a package of layers) by their extension.
 pub fn is_layer(path: &str) -> bool {
     let file = package_file(path).to_ascii_lowercase();
@@ -136,7 +197,7 @@ pub fn is_layer(path: &str) -> bool {
 
 /// The outer file of a package-relative path (`/a/b.usdz[c/d.usdc]` → `/a/b.usdz`), or the
 /// path itself.
-fn package_file(path: &str) -> &str {
+pub fn package_file(path: &str) -> &str {
     match (path.find('['), path.ends_with(']')) {
         (Some(open), true) => &path[..open],
         _ => path,

@@ -70,6 +70,15 @@ pub(super) fn as_vec2s(v: &sdf::Value) -> Option<Vec<Vec2>> {
     }
 }
 
+pub(super) fn as_f64s(v: &sdf::Value) -> Option<Vec<f64>> {
+    match v {
+        sdf::Value::FloatVec(a) => Some(a.iter().map(|&x| x as f64).collect()),
+        sdf::Value::DoubleVec(a) => Some(a.clone()),
+        sdf::Value::HalfVec(a) => Some(a.iter().map(|x| x.to_f32() as f64).collect()),
+        _ => None,
+    }
+}
+
 pub(super) fn as_ints(v: &sdf::Value) -> Option<Vec<i64>> {
     match v {
         sdf::Value::IntVec(a) => Some(a.iter().map(|&i| i as i64).collect()),
@@ -82,14 +91,6 @@ pub(super) fn as_ints(v: &sdf::Value) -> Option<Vec<i64>> {
 pub(super) fn as_token(v: &sdf::Value) -> Option<String> {
     match v {
         sdf::Value::Token(t) => Some(t.as_str().to_string()),
-        sdf::Value::String(s) => Some(s.clone()),
-        _ => None,
-    }
-}
-
-pub(super) fn as_asset(v: &sdf::Value) -> Option<String> {
-    match v {
-        sdf::Value::AssetPath(a) => Some(a.authored_path.clone()),
         sdf::Value::String(s) => Some(s.clone()),
         _ => None,
     }
