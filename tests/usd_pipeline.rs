@@ -1,0 +1,212 @@
+//! USD as studios and Apple's tools write it, checked against the answers Pixar's own
+//! library computes for the same stages (`tools/make_usd_pipeline.py` writes both: the
+//! stages under `tests/scenes/usd_pipeline/` and a JSON file of answers beside each).
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use gridtrace::load::{Loaded, load_scene};
+use gridtrace::scene::{AlphaMode, Material, Scene};
+use serde_json::Value;
+
+const DIR: &str = "tests/scenes/usd_pipeline";
+
+fn answers(name: &str) -> Value {
+    let text = std::fs::read_to_string(Path::new(DIR).join(name)).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+fn load_clean(path: &Path) -> Loaded {
+    let loaded = load_scene(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        loaded.warnings.is_empty(),
+        "{}: unexpected warnings {:#?}",
+        path.display(),
+        loaded.warnings
+    );
+    loaded
+}
+
+/// The material of the mesh named `prim`, without the one-sided suffix in its name.
+fn material_of<'a>(scene: &'a Scene, prim: &str) -> &'a Material {
+    let mesh = scene
+        .meshes
+        .iter()
+        .find(|m| m.name == prim)
+        .unwrap_or_else(|| panic!("no mesh {prim}"));
+    &scene.materials[mesh.material]
+}
+
+fn material_path(material: &Material) -> &str {
+    material.name.trim_end_matches(" (one-sided)")
+}
+
+/// The first texel of the base-colour texture of `material`, 8-bit.
+fn base_texel(scene: &Scene, material: &Material) -> [u8; 3] {
+    let texture = material
+        .textures
+        .base_colour
+        .as_ref()
+        .unwrap_or_else(|| panic!("{} has no base-colour texture", material.name))
+        .texture;
+    let t = scene.textures[texture].texels[0];
+    [0, 1, 2].map(|c| (t[c] / 257) as u8)
+}
+
+fn first_pixel(png: &Path) -> [u8; 3] {
+    let image = image::open(png).unwrap().to_rgb8();
+    image.get_pixel(0, 0).0
+}
+
+/// A texture named by a sublayer or a referenced layer in another folder is found beside
+/// that layer (where `Sdf.ComputeAssetPathRelativeToLayer` puts it), not beside the root
+/// stage, where decoys of another colour wait.
+#[test]
+fn asset_paths_resolve_against_the_layer_that_names_them() {
+    let case = Path::new(DIR).join("assets");
+    let loaded = load_clean(&case.join("shot.usda"));
+    let expected = answers("assets/expected.json");
+    let files: BTreeSet<PathBuf> = loaded
+        .files
+        .iter()
+        .map(|d| d.path.canonicalize().unwrap())
+        .collect();
+    let textures = expected["textures"].as_object().unwrap();
+    assert_eq!(textures.len(), 2);
+    for (shader, answer) in textures {
+        let anchored = case.join(answer["anchored"].as_str().unwrap());
+        let resolved = case.join(answer["resolved"].as_str().unwrap());
+        assert_eq!(anchored, resolved, "{shader}: USD's own two answers differ");
+        assert!(
+            files.contains(&resolved.canonicalize().unwrap()),
+            "{shader}: {} not among the files read {files:#?}",
+            resolved.display()
+        );
+        let material = shader.trim_end_matches("/Texture");
+        let ours = loaded
+            .scene
+            .materials
+            .iter()
+            .find(|m| material_path(m) == material)
+            .unwrap_or_else(|| panic!("no material {material}"));
+        assert_eq!(
+            base_texel(&loaded.scene, ours),
+            first_pixel(&resolved),
+            "{shader}: the texture read is not the one the authoring layer names"
+        );
+    }
+}
+
+/// A `.usdz` written by `UsdUtils.CreateNewUsdzPackage`, alone in a folder: its layers and
+/// a texture two folders deep inside the archive are read from the archive.
+#[test]
+fn a_usdz_package_alone_reads_its_layers_and_textures_from_inside() {
+    let dir = tempfile::tempdir().unwrap();
+    let alone = dir.path().join("package.usdz");
+    std::fs::copy(Path::new(DIR).join("package.usdz"), &alone).unwrap();
+    let loaded = load_clean(&alone);
+    let inside = answers("package.json")["texture_resolved_inside"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert_eq!(inside, "[maps/deep/wood.png]");
+    let material = material_of(&loaded.scene, "/Root/Top");
+    assert_eq!(material_path(material), "/Root/Looks/Wood");
+    assert_eq!(base_texel(&loaded.scene, material), [180, 120, 40]);
+    // Everything came from the archive itself.
+    assert!(loaded.files.is_empty(), "{:?}", loaded.files);
+}
+
+/// Every mesh gets the material `ComputeBoundMaterial` (full purpose) gives: inherited from
+/// an ancestor, an ancestor's `strongerThanDescendants`, the full purpose over all-purpose
+/// and never the preview one, a collection binding; and each material's surface is the
+/// shader `ComputeSurfaceSource` finds, with the values its inputs' value-producing
+/// attributes give (through a NodeGraph and the material's interface input).
+#[test]
+fn bound_materials_and_surfaces_are_the_ones_usd_computes() {
+    let loaded = load_clean(&Path::new(DIR).join("materials.usda"));
+    let expected = answers("materials.json");
+    let bound = expected["bound"].as_object().unwrap();
+    assert_eq!(bound.len(), 6);
+    for (mesh, material) in bound {
+        let material = material.as_str().unwrap();
+        let ours = material_of(&loaded.scene, mesh);
+        assert_eq!(material_path(ours), material, "{mesh}");
+        let surface = &expected["surface"][material];
+        let diffuse: Vec<f32> = surface["diffuse"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap() as f32)
+            .collect();
+        assert_eq!(ours.pbr.base_colour.to_array().to_vec(), diffuse, "{mesh}");
+        let roughness = surface["roughness"].as_f64().unwrap() as f32;
+        assert_eq!(ours.pbr.roughness, roughness, "{mesh}");
+    }
+}
+
+/// Without a bound material, `displayColor` (constant or per face) colours the surface and
+/// `displayOpacity` below one makes it see-through, as Hydra's fallback does.
+#[test]
+fn display_colour_and_opacity_stand_in_for_a_missing_material() {
+    let loaded = load_clean(&Path::new(DIR).join("materials.usda"));
+    let expected = answers("materials.json");
+    let display = expected["display"].as_object().unwrap();
+    assert_eq!(display.len(), 3);
+    for (prim, answer) in display {
+        let colours: BTreeSet<[u32; 3]> = answer["colours"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| [0, 1, 2].map(|i| (c[i].as_f64().unwrap() * 1000.0).round() as u32))
+            .collect();
+        let opacity = answer["opacity"]
+            .as_array()
+            .map_or(1.0, |o| o[0].as_f64().unwrap() as f32);
+        let mesh = loaded.scene.meshes.iter().find(|m| &m.name == prim).unwrap();
+        let material = &loaded.scene.materials[mesh.material];
+        assert!(material.vertex_colours, "{prim}");
+        assert_eq!(material.pbr.base_colour.to_array(), [1.0; 3], "{prim}");
+        let ours: BTreeSet<[u32; 3]> = mesh
+            .colours
+            .iter()
+            .map(|c| [c.x, c.y, c.z].map(|v| (v * 1000.0).round() as u32))
+            .collect();
+        assert_eq!(ours, colours, "{prim}");
+        assert!(mesh.colours.iter().all(|c| c.w == opacity), "{prim}");
+        let blended = matches!(material.alpha_mode, AlphaMode::Blend);
+        assert_eq!(blended, opacity < 1.0, "{prim}");
+    }
+    // Per-face colours stay with their faces: each triangle is one colour.
+    let per_face = loaded
+        .scene
+        .meshes
+        .iter()
+        .find(|m| m.name == "/World/DisplayPerFace")
+        .unwrap();
+    for [a, b, c] in &per_face.indices {
+        let [a, b, c] = [a, b, c].map(|&i| per_face.colours[i as usize]);
+        assert!(a == b && b == c);
+    }
+}
+
+/// `over` prims (a flattened stage's prototypes) and abstract `class` prims are not drawn;
+/// a defined prim inheriting from a class is, with what it inherits: exactly the gprims
+/// `Usd.PrimRange` visits with its default predicate.
+#[test]
+fn only_the_prims_usd_traverses_are_drawn() {
+    let loaded = load_clean(&Path::new(DIR).join("prims.usda"));
+    let expected: BTreeSet<String> = answers("prims.json")["drawn"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_str().unwrap().to_string())
+        .collect();
+    let drawn: BTreeSet<String> = loaded
+        .scene
+        .instances
+        .iter()
+        .map(|i| loaded.scene.meshes[i.mesh].name.clone())
+        .collect();
+    assert_eq!(drawn, expected);
+}
