@@ -5,7 +5,7 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use gridtrace::load::{Loaded, load_scene};
+use gridtrace::load::{LoadOptions, Loaded, load_scene, load_scene_with};
 use gridtrace::scene::{AlphaMode, Material, Scene};
 use serde_json::Value;
 
@@ -163,7 +163,12 @@ fn display_colour_and_opacity_stand_in_for_a_missing_material() {
         let opacity = answer["opacity"]
             .as_array()
             .map_or(1.0, |o| o[0].as_f64().unwrap() as f32);
-        let mesh = loaded.scene.meshes.iter().find(|m| &m.name == prim).unwrap();
+        let mesh = loaded
+            .scene
+            .meshes
+            .iter()
+            .find(|m| &m.name == prim)
+            .unwrap();
         let material = &loaded.scene.materials[mesh.material];
         assert!(material.vertex_colours, "{prim}");
         assert_eq!(material.pbr.base_colour.to_array(), [1.0; 3], "{prim}");
@@ -209,4 +214,111 @@ fn only_the_prims_usd_traverses_are_drawn() {
         .map(|i| loaded.scene.meshes[i.mesh].name.clone())
         .collect();
     assert_eq!(drawn, expected);
+}
+
+/// Rows of a USD (row-vector) matrix as glam's column-vector matrix: the same numbers.
+fn usd_matrix(rows: &Value) -> glam::Mat4 {
+    let r: Vec<f32> = rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|row| row.as_array().unwrap().iter())
+        .map(|v| v.as_f64().unwrap() as f32)
+        .collect();
+    glam::Mat4::from_cols_slice(&r)
+}
+
+/// A PointInstancer at frame 4 (between position samples at 1 and 10) places each visible
+/// instance of each prototype where `ComputeInstanceTransformsAtTime` (with the prototype's
+/// own transform and the invisibleIds mask) times the instancer's world transform puts it,
+/// and its instances share the prototype's meshes.
+#[test]
+fn point_instancer_places_instances_where_usd_computes() {
+    let path = Path::new(DIR).join("instancer.usda");
+    let expected = answers("instancer.json");
+    let options = LoadOptions {
+        frame: expected["frame"].as_f64(),
+        ..LoadOptions::default()
+    };
+    let loaded = load_scene_with(&path, &options).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:#?}", loaded.warnings);
+    let scene = &loaded.scene;
+    let rock_from_slab = usd_matrix(&expected["rock_from_slab"]);
+    let instances = expected["instances"].as_array().unwrap();
+    assert_eq!(instances.len(), 5, "one of six is invisible");
+    assert_eq!(scene.instances.len(), instances.len());
+    for (i, instance) in instances.iter().enumerate() {
+        let placed = usd_matrix(&instance["instancer_from_proto"]);
+        let (mesh, world) = match instance["prototype"].as_str().unwrap() {
+            "Ball" => ("/World/Scatter/Protos/Ball", placed),
+            _ => ("/World/Scatter/Protos/Rock/Slab", placed * rock_from_slab),
+        };
+        let found = scene.instances.iter().any(|ours| {
+            scene.meshes[ours.mesh].name == mesh
+                && glam::Mat4::from(ours.world_from_object).abs_diff_eq(world, 1e-4)
+        });
+        assert!(found, "instance {i} of {mesh} not at\n{world}");
+    }
+    let meshes: BTreeSet<usize> = scene.instances.iter().map(|i| i.mesh).collect();
+    assert_eq!(meshes.len(), 2, "instances copy their prototype's meshes");
+}
+
+/// Sphere, Cube, Cylinder, Cone, Capsule and Plane prims are drawn, each filling the world
+/// bounds `UsdGeom.BBoxCache` gives it, the sphere's vertices on the sphere and its area
+/// that of the sphere.
+#[test]
+fn implicit_prims_fill_the_bounds_usd_computes() {
+    let loaded = load_clean(&Path::new(DIR).join("implicit.usda"));
+    let scene = &loaded.scene;
+    let bounds = answers("implicit.json")["bounds"].clone();
+    let bounds = bounds.as_object().unwrap();
+    assert_eq!(bounds.len(), 6);
+    for (prim, answer) in bounds {
+        let corner = |i: usize| {
+            let c = answer[i].as_array().unwrap();
+            glam::Vec3::from_array([0, 1, 2].map(|k| c[k].as_f64().unwrap() as f32))
+        };
+        let instance = scene
+            .instances
+            .iter()
+            .find(|i| &scene.meshes[i.mesh].name == prim)
+            .unwrap_or_else(|| panic!("{prim} not drawn"));
+        let mesh = &scene.meshes[instance.mesh];
+        let world: Vec<glam::Vec3> = mesh
+            .positions
+            .iter()
+            .map(|&p| instance.world_from_object.transform_point3(p))
+            .collect();
+        let min = world.iter().fold(glam::Vec3::INFINITY, |a, &p| a.min(p));
+        let max = world
+            .iter()
+            .fold(glam::Vec3::NEG_INFINITY, |a, &p| a.max(p));
+        assert!(
+            min.abs_diff_eq(corner(0), 1e-4) && max.abs_diff_eq(corner(1), 1e-4),
+            "{prim}: bounds {min}..{max}, USD says {}..{}",
+            corner(0),
+            corner(1)
+        );
+    }
+    let sphere = scene
+        .meshes
+        .iter()
+        .find(|m| m.name == "/World/Sphere")
+        .unwrap();
+    assert!(
+        sphere
+            .positions
+            .iter()
+            .all(|p| (p.length() - 0.5).abs() < 1e-6)
+    );
+    let area: f32 = sphere
+        .indices
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| sphere.positions[i as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum();
+    let exact = 4.0 * std::f32::consts::PI * 0.25;
+    assert!((area / exact - 1.0).abs() < 0.005, "area {area} vs {exact}");
 }

@@ -331,7 +331,13 @@ def instancer(out: Path) -> None:
     time = Usd.TimeCode(FRAME)
     cache = UsdGeom.XformCache(time)
     instancer_world = cache.GetLocalToWorldTransform(scatter.GetPrim())
-    transforms = scatter.ComputeInstanceTransformsAtTime(time, time)
+    # Unmasked, so the list lines up with protoIndices; the mask is applied below.
+    transforms = scatter.ComputeInstanceTransformsAtTime(
+        time,
+        time,
+        UsdGeom.PointInstancer.IncludeProtoXform,
+        UsdGeom.PointInstancer.IgnoreMask,
+    )
     mask = scatter.ComputeMaskAtTime(time)
     proto_indices = scatter.GetProtoIndicesAttr().Get(time)
     instances = []

@@ -48,12 +48,18 @@ impl UsdLoader {
         let (mut polygons, dimensions) = match kind {
             "Sphere" => {
                 let r = get("radius", 1.0);
-                (lathe(&sphere_rings(r, 0.0, -PI / 2.0, PI / 2.0, RINGS), &axis), vec![r])
+                (
+                    lathe(&sphere_rings(r, 0.0, -PI / 2.0, PI / 2.0, RINGS), &axis),
+                    vec![r],
+                )
             }
             "Cylinder" | "Cylinder_1" => {
                 let (bottom, top) = radii(1.0);
                 let h = get("height", 2.0);
-                (lathe(&frustum_rings(bottom, top, h), &axis), vec![bottom, top, h])
+                (
+                    lathe(&frustum_rings(bottom, top, h), &axis),
+                    vec![bottom, top, h],
+                )
             }
             "Cone" => {
                 let (r, h) = (get("radius", 1.0), get("height", 2.0));
@@ -62,7 +68,10 @@ impl UsdLoader {
             "Capsule" | "Capsule_1" => {
                 let (bottom, top) = radii(0.5);
                 let h = get("height", 1.0);
-                (lathe(&capsule_rings(bottom, top, h), &axis), vec![bottom, top, h])
+                (
+                    lathe(&capsule_rings(bottom, top, h), &axis),
+                    vec![bottom, top, h],
+                )
             }
             "Cube" => {
                 let s = get("size", 2.0);
@@ -92,7 +101,8 @@ impl UsdLoader {
             .as_ref()
             .and_then(as_bool)
             .unwrap_or(kind == "Plane");
-        polygons.left_handed = self.get_token(&path, "orientation").as_deref() == Some("leftHanded");
+        polygons.left_handed =
+            self.get_token(&path, "orientation").as_deref() == Some("leftHanded");
         polygons.face_material = vec![self.bound_material(&path); polygons.counts.len()];
         self.read_display(&path, &mut polygons);
         Some(polygons)
@@ -166,9 +176,7 @@ fn lathe(rings: &[Ring], axis: &str) -> Polygons {
         for j in 0..columns {
             let (sin, cos) = (2.0 * PI * j as f32 / SEGMENTS as f32).sin_cos();
             let radial = cos * u + sin * v;
-            polygons
-                .points
-                .push(ring.radius * radial + ring.height * n);
+            polygons.points.push(ring.radius * radial + ring.height * n);
             normals.push((ring.normal.x * radial + ring.normal.y * n).normalize_or_zero());
         }
     }
@@ -268,7 +276,10 @@ mod tests {
     #[test]
     fn surfaces_of_revolution_face_outwards_on_every_axis() {
         for axis in ["X", "Y", "Z"] {
-            outward(&lathe(&sphere_rings(1.0, 0.0, -PI / 2.0, PI / 2.0, RINGS), axis));
+            outward(&lathe(
+                &sphere_rings(1.0, 0.0, -PI / 2.0, PI / 2.0, RINGS),
+                axis,
+            ));
             outward(&lathe(&frustum_rings(1.0, 0.5, 2.0), axis));
             outward(&lathe(&frustum_rings(1.0, 0.0, 2.0), axis));
             outward(&lathe(&capsule_rings(0.5, 0.5, 1.0), axis));

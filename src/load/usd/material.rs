@@ -6,8 +6,8 @@ use glam::{Affine2, Vec2, Vec3};
 use openusd::sdf;
 
 use super::UsdLoader;
-use super::value::{as_f64, as_token, as_vec3};
 use super::resolver::{package_file, read_asset};
+use super::value::{as_f64, as_token, as_vec3};
 use crate::load::images::{decode_environment, decode_texture};
 use crate::scene::{
     AlphaMode, ChannelRef, ColorSpace, EnvironmentMap, Material, MaterialTextures, Pbr, TextureRef,
@@ -256,7 +256,10 @@ impl UsdLoader {
         let file = asset.as_str().to_string();
         let texture = self.texture_file(&asset, material)?;
         if matches!(space, ColorSpace::Srgb)
-            && self.input_token(&node, "inputs:sourceColorSpace").as_deref() == Some("raw")
+            && self
+                .input_token(&node, "inputs:sourceColorSpace")
+                .as_deref()
+                == Some("raw")
         {
             self.warn(format!(
                 "{material}: {input} reads '{file}' as raw data; treated as sRGB colour"

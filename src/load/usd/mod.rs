@@ -15,6 +15,8 @@ use glam::{Mat4, Vec3};
 use openusd::{sdf, usd};
 
 mod camera;
+mod implicit;
+mod instancer;
 mod light;
 mod material;
 mod mesh;
@@ -112,6 +114,7 @@ fn read_stage(path: &Path, time: Option<f64>, roots: &AssetRoots) -> Result<Load
         materials: HashMap::new(),
         collections: HashMap::new(),
         collecting: None,
+        placed_by_instancers: 0,
         default_material: None,
         one_sided: HashMap::new(),
         textures: HashMap::new(),
@@ -180,6 +183,8 @@ struct UsdLoader {
     /// Meshes and transforms relative to a PointInstancer prototype's root, while one is
     /// being collected ([`UsdLoader::place`] puts them here instead of into the scene).
     collecting: Option<Vec<(usize, Mat4)>>,
+    /// Instances point instancers have placed so far, held to the memory budget.
+    placed_by_instancers: u64,
     /// Collection membership, computed once per collection.
     collections: network::Collections,
     default_material: Option<usize>,
@@ -294,7 +299,12 @@ impl UsdLoader {
         Ok((local, resets))
     }
 
-    fn visit(&mut self, prim: &usd::Prim, parent: Mat4, depth: usize) -> Result<(), LoadError> {
+    pub(super) fn visit(
+        &mut self,
+        prim: &usd::Prim,
+        parent: Mat4,
+        depth: usize,
+    ) -> Result<(), LoadError> {
         let path = prim.path().clone();
         let where_ = path.as_str().to_string();
         if depth > MAX_DEPTH {
@@ -307,7 +317,7 @@ impl UsdLoader {
         // prototypes) and an abstract `class` are not, with their subtrees, as
         // `Usd.PrimRange`'s default predicate has it.
         if !prim.is_active().unwrap_or(true)
-            || !prim.is_defined().unwrap_or(true)
+            || (!prim.is_defined().unwrap_or(true) && self.collecting.is_none())
             || prim.is_abstract().unwrap_or(false)
         {
             return Ok(());
@@ -342,19 +352,38 @@ impl UsdLoader {
         if !world.is_finite() {
             return Err(self.invalid(format!("{where_}: non-finite transform")));
         }
+        let in_prototype = self.collecting.is_some();
         match type_name.as_str() {
             "Mesh" => self.add_mesh(prim, world)?,
+            "Sphere" | "Cube" | "Cylinder" | "Cylinder_1" | "Cone" | "Capsule" | "Capsule_1"
+            | "Plane" => {
+                if let Some(polygons) = self.read_implicit(prim, &type_name) {
+                    let meshes = self.emit(&where_, &polygons);
+                    self.place(&meshes, world, &where_);
+                }
+            }
+            "PointInstancer" => {
+                // Its children are prototypes, drawn only where it places them.
+                return self.add_instancer(prim, world, depth);
+            }
+            "Camera" | "RectLight" | "DiskLight" | "SphereLight" | "DistantLight" | "DomeLight"
+            | "DomeLight_1"
+                if in_prototype =>
+            {
+                self.warn(format!(
+                    "{where_}: {type_name} inside a PointInstancer prototype is not instanced; skipped"
+                ))
+            }
             "Camera" => self.add_camera(&path, world),
             "RectLight" | "DiskLight" | "SphereLight" | "DistantLight" => {
                 self.add_light(&path, &type_name, world)
             }
             "DomeLight" | "DomeLight_1" => self.add_dome(&path, world),
             "" | "Xform" | "Scope" | "SkelRoot" => {}
-            "Sphere" | "Cube" | "Cylinder" | "Cone" | "Capsule" | "Plane" | "Points"
-            | "BasisCurves" | "NurbsCurves" | "NurbsPatch" | "PointInstancer" | "Volume" => self
-                .warn(format!(
-                    "{where_}: {type_name} prims are not supported; skipped"
-                )),
+            "Points" | "BasisCurves" | "NurbsCurves" | "NurbsPatch" | "HermiteCurves"
+            | "TetMesh" | "Volume" => self.warn(format!(
+                "{where_}: {type_name} prims are not supported; skipped"
+            )),
             _ => {}
         }
         let children = prim

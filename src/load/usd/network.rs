@@ -69,7 +69,10 @@ impl UsdLoader {
         };
         let collection_prefix = format!("{}:", suffix("material:binding:collection"));
         let names = self.stage.prim(at.clone()).property_names().ok()?;
-        for name in names.iter().filter_map(|n| n.strip_prefix(&collection_prefix)) {
+        for name in names
+            .iter()
+            .filter_map(|n| n.strip_prefix(&collection_prefix))
+        {
             // A purpose-free name `material:binding:collection:NAME` must not be read as
             // the purpose `NAME`: only names without a further colon belong here.
             if name.contains(':') {
@@ -145,12 +148,12 @@ impl UsdLoader {
             .collect();
         contexts.sort();
         terminals.extend(contexts);
-        terminals.iter().find_map(|terminal| {
-            match self.source_of(material, terminal)? {
+        terminals
+            .iter()
+            .find_map(|terminal| match self.source_of(material, terminal)? {
                 Source::Node { prim, .. } => Some(prim),
                 Source::Value(_) => None,
-            }
-        })
+            })
     }
 
     /// What feeds `property` of `prim`: connections are followed through NodeGraph and
@@ -159,9 +162,7 @@ impl UsdLoader {
     pub(super) fn source_of(&self, prim: &sdf::Path, property: &str) -> Option<Source> {
         let (mut prim, mut property) = (prim.clone(), property.to_string());
         for _ in 0..MAX_HOPS {
-            let attribute = self
-                .stage
-                .attribute(prim.append_property(&property).ok()?);
+            let attribute = self.stage.attribute(prim.append_property(&property).ok()?);
             let Some(source) = attribute.connections().ok()?.into_iter().next() else {
                 return attribute
                     .get_at::<sdf::Value>(self.time)

@@ -136,8 +136,7 @@ pub fn read_asset(resolved: &str) -> io::Result<Vec<u8>> {
         return Err(io::Error::other(format!("{package}: not a regular file")));
     }
     let archive = std::fs::File::open(&package)?;
-    read_member(archive, &inner, budget, 0)
-        .map_err(|e| io::Error::other(format!("{package}: {e}")))
+    read_member(archive, &inner, budget, 0).map_err(|e| io::Error::other(format!("{package}: {e}")))
 }
 
 /// Deepest nesting of packages inside packages read.
@@ -163,8 +162,12 @@ fn read_member(
         Some((member, rest)) => (member, Some(rest)),
         None => (inner.to_string(), None),
     };
-    let mut zip = zip::ZipArchive::new(archive)
-        .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("not a zip archive: {e}")))?;
+    let mut zip = zip::ZipArchive::new(archive).map_err(|e| {
+        io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("not a zip archive: {e}"),
+        )
+    })?;
     let entry = zip
         .by_name(&member)
         .map_err(|_| io::Error::new(io::ErrorKind::NotFound, format!("no member '{member}'")))?;
