@@ -56,8 +56,8 @@ fn roughness_texture_and_normal_map_from_usd_match_cycles() {
     check("principled_textured", "usdc", SPP);
 }
 
-/// Rough glass (0.2), lit through it onto the floor. glTF only: Blender's USD exporter
-/// writes no transmission.
+/// Rough glass (0.2), lit through it onto the floor. The .usdc's glass (through its
+/// MaterialX surface) is checked to be this same material in `usd_pipeline`.
 #[test]
 fn rough_glass_matches_cycles() {
     check("principled_glass", "glb", 2 * SPP);

@@ -322,3 +322,31 @@ fn implicit_prims_fill_the_bounds_usd_computes() {
     let exact = 4.0 * std::f32::consts::PI * 0.25;
     assert!((area / exact - 1.0).abs() < 0.005, "area {area} vs {exact}");
 }
+
+/// Blender glass through the USD exporter with its MaterialX network on: the OpenPBR
+/// surface's transmission reaches the material, which then equals the glTF export's glass
+/// (whose render is compared with Cycles in `principled_references`).
+#[test]
+fn blender_glass_from_usd_with_materialx_is_the_gltf_glass() {
+    let usd = load_scene(Path::new("tests/scenes/principled_glass.usdc")).unwrap();
+    let gltf = load_scene(Path::new("tests/scenes/principled_glass.glb")).unwrap();
+    let find = |scene: &Scene| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name.contains("RoughGlass"))
+            .cloned()
+            .unwrap()
+    };
+    let (usd, gltf) = (find(&usd.scene), find(&gltf.scene));
+    assert_eq!(usd.pbr.transmission, 1.0);
+    for (name, a, b) in [
+        ("transmission", usd.pbr.transmission, gltf.pbr.transmission),
+        ("roughness", usd.pbr.roughness, gltf.pbr.roughness),
+        ("ior", usd.pbr.ior, gltf.pbr.ior),
+        ("metallic", usd.pbr.metallic, gltf.pbr.metallic),
+    ] {
+        assert!((a - b).abs() < 1e-6, "{name}: USD {a}, glTF {b}");
+    }
+    assert!(usd.pbr.base_colour.abs_diff_eq(gltf.pbr.base_colour, 1e-6));
+}

@@ -18,8 +18,9 @@ clamping, no denoising, 64 bounces, black world).
   KHR_materials_sheen is Charlie's, which gridtrace follows; see the README.)
 - principled_textured: a metal panel whose roughness comes from a texture and whose normal from
   a normal map.
-- principled_glass: a rough glass ball (0.2). Blender's USD exporter writes no transmission, so
-  its .usdc has an opaque ball and is not compared.
+- principled_glass: a rough glass ball (0.2). Blender's USD exporter writes no transmission
+  into its UsdPreviewSurface, so this scene's .usdc is exported with the exporter's MaterialX
+  network on, whose OpenPBR surface carries `transmission_weight`.
 """
 
 import math
@@ -152,7 +153,7 @@ def main():
         scene = reset()
         build(scene)
         export(os.path.join(SCENES, f"{name}.glb"))
-        export_usd(os.path.join(SCENES, f"{name}.usdc"))
+        export_usd(os.path.join(SCENES, f"{name}.usdc"), materialx=name == "principled_glass")
         if not args.export_only:
             render_reference(scene, name, args.samples or samples)
     return 0

@@ -392,13 +392,16 @@ def scene_arguments(description):
     return args
 
 
-def export_usd(path):
+def export_usd(path, materialx=False):
     """Blender's USD export of the scene; textures are written beside the layer, replacing
     any left by an earlier run. An existing .usdc is removed first: USD saves over a crate
-    file by appending to it, so a re-exported file would keep growing."""
+    file by appending to it, so a re-exported file would keep growing. `materialx` turns on
+    the exporter's MaterialX network (an OpenPBR surface beside the preview one)."""
     if os.path.exists(path):
         os.remove(path)
-    bpy.ops.wm.usd_export(filepath=path, overwrite_textures=True)
+    bpy.ops.wm.usd_export(
+        filepath=path, overwrite_textures=True, generate_materialx_network=materialx
+    )
     print(f"wrote {path} ({os.path.getsize(path)} bytes)", flush=True)
 
 

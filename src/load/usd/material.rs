@@ -149,6 +149,9 @@ impl UsdLoader {
             transmission: (1.0 - opacity).clamp(0.0, 1.0),
             ..Pbr::default()
         };
+        if let Some(weight) = self.materialx_transmission(material) {
+            pbr.transmission = pbr.transmission.max(weight);
+        }
         if self.input_f32(&shader, "inputs:useSpecularWorkflow") == Some(1.0) {
             // The specular workflow gives F0 directly and has no metals.
             self.warn_if_connected(&shader, "inputs:specularColor", &name);
@@ -366,6 +369,23 @@ impl UsdLoader {
             .map_err(|e| format!("'{authored}': {e}"))?;
         self.texture_paths.push(file);
         read_asset(resolved).map_err(|e| format!("'{authored}' ({resolved}): {e}"))
+    }
+
+    /// Transmission from a MaterialX surface beside the preview one. Blender's USD export
+    /// writes none into its UsdPreviewSurface (its glass arrives with opacity 1); with the
+    /// exporter's "MaterialX network" option it also writes an OpenPBR surface
+    /// (`outputs:mtlx:surface`) whose `transmission_weight` says it (Standard Surface's
+    /// `transmission` likewise).
+    fn materialx_transmission(&self, material: &sdf::Path) -> Option<f32> {
+        let shader = self.connected_prim(material, "outputs:mtlx:surface")?;
+        let input = match self.get_token(&shader, "info:id")?.as_str() {
+            "ND_open_pbr_surface_surfaceshader" => "inputs:transmission_weight",
+            "ND_standard_surface_surfaceshader" => "inputs:transmission",
+            _ => return None,
+        };
+        self.input_f32(&shader, input)
+            .filter(|w| w.is_finite())
+            .map(|w| w.clamp(0.0, 1.0))
     }
 
     fn input_f32(&self, prim: &sdf::Path, input: &str) -> Option<f32> {
