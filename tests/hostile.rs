@@ -123,6 +123,36 @@ const CASES: &[(&str, Expect)] = &[
         "usd_negative_counts.usda",
         Expect::Error("faceVertexCounts[0] is -3"),
     ),
+    // Composition loops, packages with odd members, instancing without end.
+    ("usd_sublayer_cycle.usda", Expect::Warning("sublayer cycle")),
+    (
+        "usd_self_reference.usda",
+        Expect::Warning("composition arc cycle at /Ref"),
+    ),
+    (
+        "usd_internal_cycle.usda",
+        Expect::Warning("composition arc cycle at /A"),
+    ),
+    (
+        "usd_huge_counts.usda",
+        Expect::Error("/Huge: faceVertexCounts add up to 4294967294"),
+    ),
+    (
+        "usd_instancer_bomb.usda",
+        Expect::Error("/Outer: point instancers place more than"),
+    ),
+    (
+        "usd_instancer_bad_index.usda",
+        Expect::Warning("/Scatter: protoIndices holds 7, but there are 1 prototypes"),
+    ),
+    (
+        "usdz_odd_members.usdz",
+        Expect::Warning("/Odd: texture '../escape.png' does not resolve"),
+    ),
+    (
+        "usdz_deflate_bomb.usdz",
+        Expect::Warning("member 'big.png' declares 2684354560 bytes, more than the memory budget"),
+    ),
     (
         "camera_yfov_zero.gltf",
         Expect::Error("vertical field of view 0 rad"),

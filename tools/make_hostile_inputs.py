@@ -18,6 +18,7 @@ import os
 import random
 import struct
 import sys
+import zipfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -100,6 +101,18 @@ def star(n, inner=0.9):
         r = 1.0 if i % 2 == 0 else inner
         corners.append((r * math.cos(angle), r * math.sin(angle), 0.0))
     return corners
+
+
+def write_deflate_bomb(path, root_layer, size):
+    """A .usdz whose texture member `big.png` inflates to `size` bytes of zeros."""
+    with zipfile.ZipFile(path, "w") as z:
+        z.writestr(zipfile.ZipInfo("root.usda"), root_layer)
+        info = zipfile.ZipInfo("big.png")
+        info.compress_type = zipfile.ZIP_DEFLATED
+        chunk = bytes(1 << 24)
+        with z.open(info, "w", force_zip64=True) as member:
+            for _ in range(size // len(chunk)):
+                member.write(chunk)
 
 
 def write(path, content):
@@ -224,6 +237,93 @@ def Mesh "Floor"
     point3f[] points = [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]
 }
 """))
+    # Composition loops and packages with odd members.
+    write(j("usd_sublayer_cycle.usda"), usda(metadata="    subLayers = [@cycle_b.usda@]\n"))
+    write(j("cycle_b.usda"), usda(metadata="    subLayers = [@usd_sublayer_cycle.usda@]\n"))
+    write(j("usd_self_reference.usda"),
+          usda("def Xform \"Ref\" (\n    prepend references = @usd_self_reference.usda@</Ref>\n)\n{\n}\n"))
+    write(j("usd_internal_cycle.usda"), usda("""def Xform "A" (
+    prepend references = </B>
+)
+{
+}
+def Xform "B" (
+    prepend references = </A>
+)
+{
+}
+"""))
+    write(j("usd_huge_counts.usda"), usda("""def Mesh "Huge"
+{
+    int[] faceVertexCounts = [2147483647, 2147483647]
+    int[] faceVertexIndices = [0, 1, 2]
+    point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+}
+"""))
+    positions = ", ".join(f"({i % 100}, 0, {i // 100})" for i in range(10_000))
+    indices = ", ".join("0" for _ in range(10_000))
+    write(j("usd_instancer_bomb.usda"), usda(f"""def PointInstancer "Outer"
+{{
+    rel prototypes = </Outer/Inner>
+    int[] protoIndices = [{indices}]
+    point3f[] positions = [{positions}]
+
+    def PointInstancer "Inner"
+    {{
+        rel prototypes = </Quad>
+        int[] protoIndices = [{indices}]
+        point3f[] positions = [{positions}]
+    }}
+}}
+"""))
+    write(j("usd_instancer_bad_index.usda"), usda("""def PointInstancer "Scatter"
+{
+    rel prototypes = </Quad>
+    int[] protoIndices = [0, 7]
+    point3f[] positions = [(0, 0, 0), (3, 0, 0)]
+}
+"""))
+    root = usda("""def Material "Odd"
+{
+    token outputs:surface.connect = </Odd/Surface.outputs:surface>
+    def Shader "Surface"
+    {
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor.connect = </Odd/Image.outputs:rgb>
+        token outputs:surface
+    }
+    def Shader "Image"
+    {
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @../escape.png@
+        float3 outputs:rgb
+    }
+}
+""").replace("</Glow>", "</Odd>", 1)
+    with zipfile.ZipFile(j("usdz_odd_members.usdz"), "w", zipfile.ZIP_STORED) as z:
+        z.writestr("root.usda", root)
+        z.writestr("../escape.png", b"not an image")
+        z.writestr("/absolute.png", b"not an image")
+    bomb = usda("""def Material "Bomb"
+{
+    token outputs:surface.connect = </Bomb/Surface.outputs:surface>
+    def Shader "Surface"
+    {
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor.connect = </Bomb/Image.outputs:rgb>
+        token outputs:surface
+    }
+    def Shader "Image"
+    {
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @big.png@
+        float3 outputs:rgb
+    }
+}
+""").replace("</Glow>", "</Bomb>", 1)
+    # 2.5 GiB of zeros deflated to a few megabytes: past the 2 GiB the test allows.
+    write_deflate_bomb(j("usdz_deflate_bomb.usdz"), bomb, 5 << 29)
+
     write_json(j("camera_yfov_zero.gltf"), with_camera({"type": "perspective", "perspective": {"yfov": 0.0, "znear": 0.1}}))
     write_json(j("camera_yfov_infinite.gltf"), with_camera({"type": "perspective", "perspective": {"yfov": 1e39, "znear": 0.1}}))
     write_json(j("camera_ortho_zero.gltf"), with_camera(

@@ -108,6 +108,12 @@ pub struct Args {
     #[arg(long, value_name = "FPS", value_parser = parse_fps, requires = "frame")]
     pub fps: Option<f64>,
 
+    /// Levels of Catmull–Clark refinement for USD meshes whose subdivisionScheme asks for
+    /// it (Blender exports a Subdivision modifier as its cage with catmullClark); 0 renders
+    /// the cage. Each level has four times the faces. [default: 2, Blender's render level]
+    #[arg(long, value_name = "LEVELS", value_parser = clap::value_parser!(u32).range(0..=6))]
+    pub subdivision_level: Option<u32>,
+
     /// The glTF animation --frame evaluates, by name or index. [default: the first]
     #[arg(long, value_name = "NAME|INDEX", requires = "frame")]
     pub animation: Option<String>,

@@ -77,6 +77,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         fps: args.fps,
         animation: args.animation.clone(),
         asset_paths: args.asset_path.clone(),
+        subdivision_level: args.subdivision_level,
     };
     for dir in &args.asset_path {
         if !dir.is_dir() {
@@ -406,6 +407,9 @@ fn load_options_label(options: &LoadOptions) -> String {
     }
     if let Some(animation) = &options.animation {
         label += &format!(" animation={animation}");
+    }
+    if let Some(levels) = options.subdivision_level {
+        label += &format!(" subdivision-level={levels}");
     }
     label
 }

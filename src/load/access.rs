@@ -70,6 +70,21 @@ pub enum AccessError {
     },
 }
 
+impl AccessError {
+    /// The same refusal naming the path as `reference` (as a layer wrote it, where the
+    /// check was made on the path it resolved to).
+    pub fn naming(mut self, name: &str) -> AccessError {
+        match &mut self {
+            AccessError::Outside { reference, .. }
+            | AccessError::Scheme { reference }
+            | AccessError::NotRegular { reference, .. }
+            | AccessError::Missing { reference, .. }
+            | AccessError::Io { reference, .. } => *reference = name.to_string(),
+        }
+        self
+    }
+}
+
 /// Roots as a message lists them.
 #[derive(Debug)]
 pub struct RootList(Vec<PathBuf>);

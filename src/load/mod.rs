@@ -7,6 +7,7 @@ pub mod guard;
 mod images;
 pub mod ply;
 mod polygon;
+mod subdivision;
 mod tangents;
 pub mod usd;
 
@@ -46,9 +47,21 @@ pub struct LoadOptions {
     pub animation: Option<String>,
     /// Folders a scene may read besides its own (`--asset-path`); see [`access`].
     pub asset_paths: Vec<PathBuf>,
+    /// Levels of Catmull–Clark refinement for USD meshes that ask for subdivision
+    /// (`None`: [`DEFAULT_SUBDIVISION_LEVEL`]).
+    pub subdivision_level: Option<u32>,
 }
 
+/// Levels a subdivision surface is refined to by default: Blender's Subdivision modifier
+/// renders at level 2 unless told otherwise, and its USD export writes the cage.
+pub const DEFAULT_SUBDIVISION_LEVEL: u32 = 2;
+
 impl LoadOptions {
+    /// Levels of refinement for subdivision surfaces.
+    pub fn subdivision_levels(&self) -> u32 {
+        self.subdivision_level.unwrap_or(DEFAULT_SUBDIVISION_LEVEL)
+    }
+
     /// The frame rate turning frames into glTF seconds.
     pub fn frames_per_second(&self) -> f64 {
         self.fps.unwrap_or(24.0)

@@ -15,9 +15,13 @@ use super::UsdLoader;
 use super::value::{as_ints, as_vec3s};
 use crate::limits::memory_budget;
 use crate::load::LoadError;
+use crate::scene::Instance;
 
-/// Bytes one placed instance costs the scene, for the memory budget.
-const INSTANCE_BYTES: u64 = 128;
+/// Bytes one placed instance costs while the scene is built: the instance, its name, and
+/// room for the list holding it to grow (which may briefly hold twice its length).
+fn instance_bytes(name: &str) -> u64 {
+    3 * (std::mem::size_of::<Instance>() + name.len()) as u64
+}
 
 impl UsdLoader {
     /// Places the instances of PointInstancer `prim` (whose instancer transform is `world`).
@@ -55,7 +59,7 @@ impl UsdLoader {
         let orientations = self.orientations(&path, count, &where_);
         let scales = self.optional_per_instance(&path, "scales", count, &where_);
         let hidden = self.hidden_instances(&path, count);
-        let budget = memory_budget() / INSTANCE_BYTES;
+        let budget = memory_budget() / instance_bytes(&where_);
         let mut parts = Vec::with_capacity(prototypes.len());
         for prototype in &prototypes {
             // A prototype holding its own instancer would instance itself without end.

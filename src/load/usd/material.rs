@@ -363,10 +363,13 @@ impl UsdLoader {
             ));
         };
         let outer = package_file(resolved);
-        let file = self
-            .roots
-            .resolve(Path::new("/"), outer)
-            .map_err(|e| format!("'{authored}': {e}"))?;
+        let file =
+            self.roots
+                .resolve(Path::new("/"), outer)
+                .map_err(|e| match outer == resolved {
+                    true => e.naming(authored).to_string(),
+                    false => format!("'{authored}': {e}"),
+                })?;
         self.texture_paths.push(file);
         read_asset(resolved).map_err(|e| format!("'{authored}' ({resolved}): {e}"))
     }

@@ -9,8 +9,10 @@ use openusd::{sdf, usd};
 
 use super::UsdLoader;
 use super::value::{Interpolation, as_bool, as_f64s, as_ints, as_token, as_vec2s, as_vec3s};
+use crate::limits::check_memory;
 use crate::load::LoadError;
 use crate::load::polygon::{MAX_EAR_CLIPPED_CORNERS, fan, triangulate};
+use crate::load::subdivision::{Boundary, Cage, catmull_clark, refined_faces};
 use crate::load::tangents::generate_tangents;
 use crate::scene::{AlphaMode, Material, Mesh};
 
@@ -31,6 +33,30 @@ pub(super) struct Polygons {
     pub face_material: Vec<Option<usize>>,
     pub left_handed: bool,
     pub double_sided: bool,
+}
+
+/// Area-weighted point normals of a polygon mesh (each face's corners' cross products).
+fn smooth_normals(polygons: &Polygons) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; polygons.points.len()];
+    let mut start = 0;
+    for &count in &polygons.counts {
+        let corners = &polygons.indices[start..start + count];
+        for i in 0..count {
+            let [a, b, c] = [
+                corners[(i + count - 1) % count],
+                corners[i],
+                corners[(i + 1) % count],
+            ];
+            let p = &polygons.points;
+            normals[b] += (p[c] - p[b]).cross(p[a] - p[b]);
+        }
+        start += count;
+    }
+    let sign = if polygons.left_handed { -1.0 } else { 1.0 };
+    normals
+        .into_iter()
+        .map(|n| sign * n.normalize_or_zero())
+        .collect()
 }
 
 /// The value a primvar gives face corner `corner` of face `face` at point `point`.
@@ -377,18 +403,127 @@ impl UsdLoader {
         }
     }
 
+    /// `polygons` refined as a Catmull–Clark surface ([`catmull_clark`]). Authored normals
+    /// do not apply to a subdivision surface (UsdGeomMesh); the refined mesh gets smooth
+    /// vertex normals. Face-varying texture coordinates are interpolated linearly, per-face
+    /// data follows the face it came from, and other display colours become per face.
+    fn subdivide(&mut self, path: &sdf::Path, polygons: Polygons) -> Result<Polygons, LoadError> {
+        let where_ = path.as_str();
+        let levels = self.subdivision_levels;
+        let faces = refined_faces(&polygons.counts, levels);
+        // Each refined quad: four corners, a point, texture coordinates, triangles later.
+        check_memory(
+            || format!("{where_}: subdivision to level {levels}"),
+            faces.saturating_mul(200),
+        )
+        .map_err(|e| self.invalid(e.to_string()))?;
+        for crease in ["creaseIndices", "cornerIndices"] {
+            if self
+                .get(path, crease)
+                .as_ref()
+                .and_then(as_ints)
+                .is_some_and(|c| !c.is_empty())
+            {
+                self.warn(format!(
+                    "{where_}: {crease} are not applied; the surface is smooth there"
+                ));
+            }
+        }
+        let boundary = match self.get_token(path, "interpolateBoundary").as_deref() {
+            Some("edgeOnly") => Boundary::EdgeOnly,
+            _ => Boundary::EdgeAndCorner,
+        };
+        let corner_face: Vec<usize> = polygons
+            .counts
+            .iter()
+            .enumerate()
+            .flat_map(|(f, &c)| std::iter::repeat_n(f, c))
+            .collect();
+        let uvs = polygons.uvs.as_ref().map(|uvs| {
+            (0..polygons.indices.len())
+                .map(|c| pick(uvs, c, corner_face[c], polygons.indices[c]).unwrap_or(Vec2::ZERO))
+                .collect()
+        });
+        let cage = Cage {
+            points: polygons.points.clone(),
+            counts: polygons.counts.clone(),
+            indices: polygons.indices.clone(),
+            uvs,
+            origin: (0..polygons.counts.len()).collect(),
+        };
+        let refined = catmull_clark(&cage, boundary, levels);
+        let per_face = |values: &Option<(Vec<Vec3>, Interpolation)>| {
+            values.as_ref().map(|v| match v.1 {
+                Interpolation::Constant | Interpolation::Uniform => v.clone(),
+                _ => (
+                    (0..polygons.counts.len())
+                        .map(|f| {
+                            let first = polygons.counts[..f].iter().sum::<usize>();
+                            pick(v, first, f, polygons.indices[first]).unwrap_or(Vec3::ONE)
+                        })
+                        .collect(),
+                    Interpolation::Uniform,
+                ),
+            })
+        };
+        let remap = |values: Option<(Vec<Vec3>, Interpolation)>| {
+            values.map(|(v, i)| match i {
+                Interpolation::Uniform => (
+                    refined
+                        .origin
+                        .iter()
+                        .map(|&f| v.get(f).copied().unwrap_or(Vec3::ONE))
+                        .collect(),
+                    Interpolation::Uniform,
+                ),
+                _ => (v, i),
+            })
+        };
+        let opacity = polygons.display_opacity.clone().map(|(v, i)| match i {
+            Interpolation::Constant => (v, i),
+            _ => (
+                vec![v.iter().copied().fold(1.0f32, f32::min)],
+                Interpolation::Constant,
+            ),
+        });
+        let mut refined_polygons = Polygons {
+            normals: None,
+            uvs: refined.uvs.map(|uvs| (uvs, Interpolation::FaceVarying)),
+            display_colour: remap(per_face(&polygons.display_colour)),
+            display_opacity: opacity,
+            face_material: refined
+                .origin
+                .iter()
+                .map(|&f| polygons.face_material[f])
+                .collect(),
+            left_handed: polygons.left_handed,
+            double_sided: polygons.double_sided,
+            points: refined.points,
+            counts: refined.counts,
+            indices: refined.indices,
+        };
+        refined_polygons.normals = Some((smooth_normals(&refined_polygons), Interpolation::Vertex));
+        Ok(refined_polygons)
+    }
+
     pub(super) fn add_mesh(&mut self, prim: &usd::Prim, world: Mat4) -> Result<(), LoadError> {
         let where_ = prim.path().as_str().to_string();
         let Some(polygons) = self.read_mesh(prim)? else {
             return Ok(());
         };
-        if let Some(scheme) = self.get_token(prim.path(), "subdivisionScheme")
-            && scheme != "none"
-        {
-            self.warn(format!(
-                "{where_}: subdivisionScheme '{scheme}' is rendered as its control cage (no subdivision)"
-            ));
-        }
+        let scheme = self.get_token(prim.path(), "subdivisionScheme");
+        let polygons = match scheme.as_deref() {
+            Some("catmullClark") if self.subdivision_levels > 0 => {
+                self.subdivide(prim.path(), polygons)?
+            }
+            Some("loop") if self.subdivision_levels > 0 => {
+                self.warn(format!(
+                    "{where_}: Loop subdivision is not supported; rendered as its control cage"
+                ));
+                polygons
+            }
+            _ => polygons,
+        };
         let meshes = self.emit(&where_, &polygons);
         self.place(&meshes, world, &where_);
         Ok(())

@@ -67,9 +67,11 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError
     let time = options.frame;
     crate::load::guard::catching_panics(|| {
         if probe::may_hold_binary_layers(path) {
-            probe::probe_stage(path, || read_stage(path, time, &roots).is_ok())?;
+            probe::probe_stage(path, || {
+                read_stage(path, time, options.subdivision_levels(), &roots).is_ok()
+            })?;
         }
-        read_stage(path, time, &roots)
+        read_stage(path, time, options.subdivision_levels(), &roots)
     })
     .unwrap_or_else(|why| {
         Err(LoadError::Invalid {
@@ -79,7 +81,12 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError
     })
 }
 
-fn read_stage(path: &Path, time: Option<f64>, roots: &AssetRoots) -> Result<Loaded, LoadError> {
+fn read_stage(
+    path: &Path,
+    time: Option<f64>,
+    subdivision_levels: u32,
+    roots: &AssetRoots,
+) -> Result<Loaded, LoadError> {
     let invalid = |what: String| LoadError::Invalid {
         path: path.to_path_buf(),
         what,
@@ -110,6 +117,7 @@ fn read_stage(path: &Path, time: Option<f64>, roots: &AssetRoots) -> Result<Load
         roots: roots.clone(),
         stage,
         time,
+        subdivision_levels,
         builder: SceneBuilder::new(),
         materials: HashMap::new(),
         collections: HashMap::new(),
@@ -177,6 +185,8 @@ struct UsdLoader {
     stage: usd::Stage,
     /// When every attribute is read.
     time: usd::TimeCode,
+    /// Levels subdivision surfaces are refined to.
+    subdivision_levels: u32,
     builder: SceneBuilder,
     /// Our material index for each bound USD material prim path.
     materials: HashMap<String, usize>,

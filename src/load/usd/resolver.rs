@@ -76,12 +76,14 @@ impl Resolver for ConfinedResolver {
             Ok(()) => None,
             // A missing file is the composition's business (an unresolved layer).
             Err(AccessError::Missing { .. }) => None,
-            // A refused layer fails the load; a refused texture is the loader's to warn
-            // about, as it reads textures itself through the same policy.
+            // A refused layer fails the load. A refused texture resolves to its path so
+            // that the loader, which reads textures itself through the same policy, can
+            // say why it refuses it.
             Err(why) if is_layer(asset_path) => {
                 self.refuse(why.to_string());
                 None
             }
+            Err(_) if anchored => Some(ResolvedPath::new(asset_path)),
             Err(_) => None,
         }
     }

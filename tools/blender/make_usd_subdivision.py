@@ -1,0 +1,53 @@
+"""Blender's Subdivision modifier through its USD exporter, twice: as the cage with
+`subdivisionScheme = "catmullClark"` (the exporter's default, "Best Match"), and with the
+modifier applied at its render level (Blender's own OpenSubdiv refinement, limit surface
+on). gridtrace refines the first; `tests/usd_pipeline.rs` compares it with the second.
+
+    /tmp/bpyenv/bin/python tools/blender/make_usd_subdivision.py tests/scenes/usd_pipeline
+
+Objects: a cube (every vertex of valence 3), a capped cylinder (n-gon caps, valence 3 and
+4), and a grid with an open boundary (corners kept, as USD's edgeAndCorner default), each
+with a Subdivision modifier at Blender's defaults (render level 2).
+"""
+
+import os
+import sys
+
+import bpy
+
+
+def subdivided(obj):
+    modifier = obj.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels = 1
+    modifier.render_levels = 2
+    return obj
+
+
+def build():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(-1.5, 0.0, 0.5))
+    subdivided(bpy.context.active_object).name = "Cube"
+    bpy.ops.mesh.primitive_cylinder_add(vertices=8, radius=0.5, depth=1.0, location=(0.0, 0.0, 0.5))
+    subdivided(bpy.context.active_object).name = "Cylinder"
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=3, y_subdivisions=3, size=1.0, location=(1.5, 0.0, 0.2))
+    grid = subdivided(bpy.context.active_object)
+    grid.name = "Grid"
+    grid.data.vertices[4].co.z = 0.4
+
+
+def main():
+    out = sys.argv[-1]
+    build()
+    for name, mode in (("subdivision_cage", "BEST_MATCH"), ("subdivision_applied", "TESSELLATE")):
+        path = os.path.join(out, f"{name}.usda")
+        bpy.ops.wm.usd_export(
+            filepath=path,
+            export_subdivision=mode,
+            evaluation_mode="RENDER",
+            export_materials=False,
+        )
+        print(f"wrote {path} ({os.path.getsize(path)} bytes)")
+
+
+if __name__ == "__main__":
+    main()
