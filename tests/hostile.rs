@@ -146,6 +146,12 @@ const CASES: &[(&str, Expect)] = &[
         Expect::Warning("/Scatter: protoIndices holds 7, but there are 1 prototypes"),
     ),
     (
+        "usd_skel_bad_index.usda",
+        Expect::Warning(
+            "/Rig/Skin: skinning to /Rig/Skeleton not applied (joint index 7 for 1 joints)",
+        ),
+    ),
+    (
         "usdz_odd_members.usdz",
         Expect::Warning("/Odd: texture '../escape.png' does not resolve"),
     ),

@@ -416,3 +416,65 @@ fn blender_subdivision_cage_refines_to_blenders_own_surface() {
     );
     assert!(far > 0.05, "{far}");
 }
+
+/// USD's Z-up stage coordinates as gridtrace's Y-up world (metres per unit 1).
+fn y_up(p: &Value) -> glam::Vec3 {
+    let c = |i: usize| p[i].as_f64().unwrap() as f32;
+    glam::Vec3::new(c(0), c(2), -c(1))
+}
+
+/// Blender's armature animation exported with its skeleton (UsdSkel) is skinned at each
+/// `--frame` to where usd-core's `UsdSkel.BakeSkinning` puts every point (within 0.1 mm),
+/// and to the mesh Blender itself deforms at that frame (within 1 mm), on a column 2 m
+/// tall bending at two joints. Frame 1 is the rest pose; at 9 and 17 the bind pose is far
+/// off, so the comparison can fail.
+#[test]
+fn blender_armature_animation_is_skinned_as_usd_and_blender_pose_it() {
+    let baked = answers("skinned_baked.json");
+    let prim = "/root/Rig/Column/Cylinder";
+    let unposed = load_scene_with(
+        &Path::new(DIR).join("skinned.usdc"),
+        &LoadOptions {
+            frame: Some(1.0),
+            ..LoadOptions::default()
+        },
+    )
+    .unwrap();
+    for frame in [1, 9, 17] {
+        let options = LoadOptions {
+            frame: Some(frame as f64),
+            ..LoadOptions::default()
+        };
+        let loaded = load_scene_with(&Path::new(DIR).join("skinned.usdc"), &options).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:#?}", loaded.warnings);
+        let ours = world_points(&loaded.scene, prim);
+        let usd: Vec<glam::Vec3> = baked[prim][frame.to_string()]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(y_up)
+            .collect();
+        let (there, back) = (farthest_from(&usd, &ours), farthest_from(&ours, &usd));
+        assert!(
+            there < 1e-4 && back < 1e-4,
+            "frame {frame}: usd-core's baked points up to {there} m from ours, ours {back} m"
+        );
+        let blender = load_clean(&Path::new(DIR).join(format!("skinned_frame_{frame}.usdc")));
+        let blender = world_points(&blender.scene, prim);
+        let (there, back) = (
+            farthest_from(&blender, &ours),
+            farthest_from(&ours, &blender),
+        );
+        assert!(
+            there < 1e-3 && back < 1e-3,
+            "frame {frame}: Blender's posed points up to {there} m from ours, ours {back} m"
+        );
+        if frame != 1 {
+            let rest = world_points(&unposed.scene, prim);
+            assert!(
+                farthest_from(&ours, &rest) > 0.1,
+                "frame {frame} is not posed"
+            );
+        }
+    }
+}

@@ -321,6 +321,35 @@ def Xform "B" (
     }
 }
 """).replace("</Glow>", "</Bomb>", 1)
+    write(j("usd_skel_bad_index.usda"), usda("""def SkelRoot "Rig"
+{
+    def Skeleton "Skeleton" (
+        prepend apiSchemas = ["SkelBindingAPI"]
+    )
+    {
+        uniform token[] joints = ["Root"]
+        uniform matrix4d[] bindTransforms = [((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1))]
+        uniform matrix4d[] restTransforms = [((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1))]
+    }
+    def Mesh "Skin" (
+        prepend apiSchemas = ["SkelBindingAPI"]
+    )
+    {
+        int[] faceVertexCounts = [3]
+        int[] faceVertexIndices = [0, 1, 2]
+        point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+        int[] primvars:skel:jointIndices = [0, 7, 0] (
+            elementSize = 1
+            interpolation = "vertex"
+        )
+        float[] primvars:skel:jointWeights = [1, 1, 1] (
+            elementSize = 1
+            interpolation = "vertex"
+        )
+        rel skel:skeleton = </Rig/Skeleton>
+    }
+}
+"""))
     # 2.5 GiB of zeros deflated to a few megabytes: past the 2 GiB the test allows.
     write_deflate_bomb(j("usdz_deflate_bomb.usdz"), bomb, 5 << 29)
 

@@ -24,6 +24,9 @@ Stages (Y up, metres, so USD's numbers are gridtrace's):
   instancer's `UsdGeomXformCache` transform at frame 4.
 - `implicit.usda`: Sphere, Cube, Cylinder, Cone, Capsule and Plane prims. Answer: each
   prim's world bounds from `UsdGeom.BBoxCache`.
+- `skinned.usdc` (written by `tools/blender/make_usd_skinning.py`, run it first): its
+  skinning baked by `UsdSkel.BakeSkinning`. Answer (`skinned_baked.json`): the mesh's
+  world-space points at frames 1, 9 and 17.
 """
 
 import json
@@ -388,6 +391,33 @@ def implicit(out: Path) -> None:
     (out / "implicit.json").write_text(json.dumps({"bounds": bounds}, indent=1, sort_keys=True))
 
 
+def baked_skinning(out: Path) -> None:
+    from pxr import UsdSkel
+
+    source = out / "skinned.usdc"
+    if not source.exists():
+        print(f"{source} missing: run tools/blender/make_usd_skinning.py first", file=sys.stderr)
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        copy = Path(tmp) / "skinned.usdc"
+        shutil.copy(source, copy)
+        stage = Usd.Stage.Open(str(copy))
+        assert UsdSkel.BakeSkinning(stage.Traverse())
+        answers = {}
+        for frame in (1.0, 9.0, 17.0):
+            time = Usd.TimeCode(frame)
+            cache = UsdGeom.XformCache(time)
+            for prim in stage.Traverse():
+                if not prim.IsA(UsdGeom.Mesh):
+                    continue
+                world = cache.GetLocalToWorldTransform(prim)
+                points = UsdGeom.Mesh(prim).GetPointsAttr().Get(time)
+                answers.setdefault(str(prim.GetPath()), {})[str(int(frame))] = [
+                    [round(c, 6) for c in world.Transform(Gf.Vec3d(p))] for p in points
+                ]
+    (out / "skinned_baked.json").write_text(json.dumps(answers))
+
+
 def main() -> None:
     out = Path(sys.argv[1])
     out.mkdir(parents=True, exist_ok=True)
@@ -397,6 +427,7 @@ def main() -> None:
     prims(out)
     instancer(out)
     implicit(out)
+    baked_skinning(out)
 
 
 if __name__ == "__main__":

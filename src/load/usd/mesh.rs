@@ -35,6 +35,41 @@ pub(super) struct Polygons {
     pub double_sided: bool,
 }
 
+/// Newell's normal of a polygon (its area vector), robust for non-planar faces.
+fn face_normal(points: &[Vec3], corners: &[usize]) -> Vec3 {
+    let n = corners.len();
+    (0..n)
+        .map(|i| points[corners[i]].cross(points[corners[(i + 1) % n]]))
+        .sum()
+}
+
+/// Authored normals carried from `polygons`' points to `posed`: each face's corner normals
+/// turned by the rotation that takes the face's normal to its posed normal, which is
+/// exact for faces a joint moves rigidly and keeps hard edges hard.
+fn repose_normals(polygons: &mut Polygons, posed: &[Vec3]) {
+    let Some(normals) = polygons.normals.take() else {
+        return;
+    };
+    let mut turned = Vec::with_capacity(polygons.indices.len());
+    let mut start = 0;
+    for (face, &count) in polygons.counts.iter().enumerate() {
+        let corners = &polygons.indices[start..start + count];
+        let before = face_normal(&polygons.points, corners).normalize_or_zero();
+        let after = face_normal(posed, corners).normalize_or_zero();
+        let rotation = if before == Vec3::ZERO || after == Vec3::ZERO {
+            glam::Quat::IDENTITY
+        } else {
+            glam::Quat::from_rotation_arc(before, after)
+        };
+        for (i, &point) in corners.iter().enumerate() {
+            let n = pick(&normals, start + i, face, point).unwrap_or(before);
+            turned.push(rotation * n);
+        }
+        start += count;
+    }
+    polygons.normals = Some((turned, Interpolation::FaceVarying));
+}
+
 /// Area-weighted point normals of a polygon mesh (each face's corners' cross products).
 fn smooth_normals(polygons: &Polygons) -> Vec<Vec3> {
     let mut normals = vec![Vec3::ZERO; polygons.points.len()];
@@ -508,9 +543,16 @@ impl UsdLoader {
 
     pub(super) fn add_mesh(&mut self, prim: &usd::Prim, world: Mat4) -> Result<(), LoadError> {
         let where_ = prim.path().as_str().to_string();
-        let Some(polygons) = self.read_mesh(prim)? else {
+        let Some(mut polygons) = self.read_mesh(prim)? else {
             return Ok(());
         };
+        // A skinned mesh is posed at the load time and placed by its skeleton.
+        let mut world = world;
+        if let Some((posed, skeleton)) = self.skinned(prim, &polygons.points)? {
+            repose_normals(&mut polygons, &posed);
+            polygons.points = posed;
+            world = skeleton;
+        }
         let scheme = self.get_token(prim.path(), "subdivisionScheme");
         let polygons = match scheme.as_deref() {
             Some("catmullClark") if self.subdivision_levels > 0 => {

@@ -23,6 +23,7 @@ mod mesh;
 mod network;
 mod probe;
 mod resolver;
+mod skel;
 mod value;
 
 use resolver::{ConfinedResolver, Refusals};
