@@ -478,3 +478,59 @@ fn blender_armature_animation_is_skinned_as_usd_and_blender_pose_it() {
         }
     }
 }
+
+/// A triangle mesh with `subdivisionScheme = "loop"` is Loop-subdivided to the level asked
+/// for (four times the triangles per level), and a quad mesh asking for Loop stays its
+/// cage with a warning naming it.
+#[test]
+fn loop_subdivision_refines_triangle_meshes_to_the_level_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("loop.usda");
+    std::fs::write(
+        &path,
+        r#"#usda 1.0
+(
+    upAxis = "Y"
+    metersPerUnit = 1
+)
+def Mesh "Tetra"
+{
+    int[] faceVertexCounts = [3, 3, 3, 3]
+    int[] faceVertexIndices = [0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2]
+    point3f[] points = [(1, 1, 1), (1, -1, -1), (-1, 1, -1), (-1, -1, 1)]
+    uniform token subdivisionScheme = "loop"
+}
+def Mesh "Quad"
+{
+    int[] faceVertexCounts = [4]
+    int[] faceVertexIndices = [0, 1, 2, 3]
+    point3f[] points = [(3, 0, 0), (4, 0, 0), (4, 1, 0), (3, 1, 0)]
+    uniform token subdivisionScheme = "loop"
+}
+"#,
+    )
+    .unwrap();
+    for levels in [0u32, 1, 3] {
+        let options = LoadOptions {
+            subdivision_level: Some(levels),
+            ..LoadOptions::default()
+        };
+        let loaded = load_scene_with(&path, &options).unwrap();
+        let tetra = loaded
+            .scene
+            .meshes
+            .iter()
+            .find(|m| m.name == "/Tetra")
+            .unwrap();
+        assert_eq!(tetra.indices.len(), 4 * 4usize.pow(levels));
+        let warned = loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("/Quad: Loop subdivision needs triangles"));
+        assert_eq!(warned, levels > 0, "{:#?}", loaded.warnings);
+        if levels > 0 {
+            // The refined surface lies strictly inside the cage's bounding cube.
+            assert!(tetra.positions.iter().all(|p| p.abs().max_element() < 1.0));
+        }
+    }
+}

@@ -1,8 +1,10 @@
-//! Catmull–Clark subdivision of a polygon cage (Catmull & Clark 1978), with boundaries as
-//! OpenSubdiv and USD's `interpolateBoundary` define them, and the refined points moved to
-//! their limit positions (Halstead, Kass & DeRose 1993, §3), as Blender's Subdivision
-//! modifier does with "Use Limit Surface" (its default). Face-varying data (texture
-//! coordinates) is interpolated linearly within each face; creases are not applied.
+//! Catmull–Clark subdivision of a polygon cage (Catmull & Clark 1978) and Loop subdivision
+//! of a triangle cage (Loop 1987, with his β weights), with boundaries as OpenSubdiv and
+//! USD's `interpolateBoundary` define them, and the refined points moved to their limit
+//! positions (Catmull–Clark: Halstead, Kass & DeRose 1993, §3; Loop: Loop 1987, §3.3), as
+//! Blender's Subdivision modifier does with "Use Limit Surface" (its default). Face-varying
+//! data (texture coordinates) is interpolated linearly within each face; creases are not
+//! applied.
 
 use std::collections::HashMap;
 
@@ -54,6 +56,149 @@ pub fn catmull_clark(cage: &Cage, boundary: Boundary, levels: u32) -> Cage {
         mesh.points = limit_positions(&mesh, boundary);
     }
     mesh
+}
+
+/// `cage`, all triangles, refined `levels` times by Loop's scheme, its points on the limit
+/// surface. Each level has four times the triangles.
+pub fn loop_subdivision(cage: &Cage, boundary: Boundary, levels: u32) -> Cage {
+    let mut mesh = cage.clone();
+    for _ in 0..levels {
+        mesh = refine_loop(&mesh, boundary);
+    }
+    if levels > 0 {
+        mesh.points = loop_limit(&mesh, boundary);
+    }
+    mesh
+}
+
+/// Loop's β for an interior vertex of valence `n`.
+fn loop_beta(n: usize) -> f32 {
+    let n = n as f32;
+    let c = 0.375 + 0.25 * (2.0 * std::f32::consts::PI / n).cos();
+    (0.625 - c * c) / n
+}
+
+/// Neighbours of each point, and the two boundary neighbours of boundary points.
+fn neighbours(mesh: &Cage, edges: &Edges) -> (Vec<Vec<usize>>, Vec<Vec<usize>>, Vec<usize>) {
+    let n = mesh.points.len();
+    let (mut ring, mut border) = (vec![Vec::new(); n], vec![Vec::new(); n]);
+    for (e, &[a, b]) in edges.ends.iter().enumerate() {
+        ring[a].push(b);
+        ring[b].push(a);
+        if edges.faces[e].len() != 2 {
+            border[a].push(b);
+            border[b].push(a);
+        }
+    }
+    let mut faces = vec![0usize; n];
+    for &v in &mesh.indices {
+        faces[v] += 1;
+    }
+    (ring, border, faces)
+}
+
+/// A boundary point's new position by the cubic B-spline rule, or `None` when it stays
+/// (a corner kept by `EdgeAndCorner`, or a non-manifold point).
+fn boundary_rule(
+    points: &[Vec3],
+    v: usize,
+    border: &[usize],
+    faces: usize,
+    boundary: Boundary,
+    (side, centre): (f32, f32),
+) -> Option<Vec3> {
+    let corner = faces == 1 && boundary == Boundary::EdgeAndCorner;
+    if border.len() != 2 || corner {
+        return None;
+    }
+    Some(side * (points[border[0]] + points[border[1]]) + centre * points[v])
+}
+
+/// One level of Loop subdivision.
+fn refine_loop(mesh: &Cage, boundary: Boundary) -> Cage {
+    let edges = edges(mesh);
+    let (ring, border, faces) = neighbours(mesh, &edges);
+    let p = &mesh.points;
+    // Edge points: 3/8 of each end and 1/8 of each opposite corner, or the midpoint.
+    let mut opposite = vec![Vec3::ZERO; edges.ends.len()];
+    for (t, tri) in mesh.indices.chunks(3).enumerate() {
+        for i in 0..3 {
+            opposite[edges.of_corner[3 * t + i]] += p[tri[(i + 2) % 3]];
+        }
+    }
+    let edge_points = edges.ends.iter().enumerate().map(|(e, &[a, b])| {
+        if edges.faces[e].len() == 2 {
+            0.375 * (p[a] + p[b]) + 0.125 * opposite[e]
+        } else {
+            0.5 * (p[a] + p[b])
+        }
+    });
+    let vertex_points = (0..p.len()).map(|v| {
+        if ring[v].is_empty() {
+            return p[v];
+        }
+        if !border[v].is_empty() {
+            return boundary_rule(p, v, &border[v], faces[v], boundary, (0.125, 0.75))
+                .unwrap_or(p[v]);
+        }
+        let beta = loop_beta(ring[v].len());
+        (1.0 - ring[v].len() as f32 * beta) * p[v]
+            + beta * ring[v].iter().map(|&u| p[u]).sum::<Vec3>()
+    });
+    let base = p.len();
+    let mut refined = Cage {
+        points: vertex_points.chain(edge_points).collect(),
+        uvs: mesh.uvs.as_ref().map(|_| Vec::new()),
+        ..Cage::default()
+    };
+    for (t, tri) in mesh.indices.chunks(3).enumerate() {
+        let e = [0, 1, 2].map(|i| base + edges.of_corner[3 * t + i]);
+        let children = [
+            [tri[0], e[0], e[2]],
+            [tri[1], e[1], e[0]],
+            [tri[2], e[2], e[1]],
+            [e[0], e[1], e[2]],
+        ];
+        for child in children {
+            refined.counts.push(3);
+            refined.origin.push(mesh.origin[t]);
+            refined.indices.extend(child);
+        }
+        if let (Some(uvs), Some(out)) = (&mesh.uvs, &mut refined.uvs) {
+            let c = [uvs[3 * t], uvs[3 * t + 1], uvs[3 * t + 2]];
+            let m = [
+                0.5 * (c[0] + c[1]),
+                0.5 * (c[1] + c[2]),
+                0.5 * (c[2] + c[0]),
+            ];
+            out.extend([
+                c[0], m[0], m[2], c[1], m[1], m[0], c[2], m[2], m[1], m[0], m[1], m[2],
+            ]);
+        }
+    }
+    refined
+}
+
+/// Limit positions of a Loop mesh: interior points `(1 − n χ) p + χ Σ neighbours` with
+/// χ = 1 / (3 / (8 β) + n); boundary points by the cubic B-spline's `(e₀ + 4 p + e₁) / 6`.
+fn loop_limit(mesh: &Cage, boundary: Boundary) -> Vec<Vec3> {
+    let edges = edges(mesh);
+    let (ring, border, faces) = neighbours(mesh, &edges);
+    let p = &mesh.points;
+    (0..p.len())
+        .map(|v| {
+            if ring[v].is_empty() {
+                return p[v];
+            }
+            if !border[v].is_empty() {
+                return boundary_rule(p, v, &border[v], faces[v], boundary, (1.0 / 6.0, 4.0 / 6.0))
+                    .unwrap_or(p[v]);
+            }
+            let n = ring[v].len() as f32;
+            let chi = 1.0 / (3.0 / (8.0 * loop_beta(ring[v].len())) + n);
+            (1.0 - n * chi) * p[v] + chi * ring[v].iter().map(|&u| p[u]).sum::<Vec3>()
+        })
+        .collect()
 }
 
 /// Edges of a mesh: for each undirected edge its faces, and for each face corner the edge
@@ -297,9 +442,10 @@ mod tests {
         }
     }
 
-    /// The limit surface of a cube is a known smooth blob: every face centre's limit point
-    /// is at 5/9 of the half-edge from the centre (the bicubic patch value at its middle)
-    /// after any number of levels, and the surface converges as levels grow.
+    /// The limit point at the middle of a face of the cube [−1, 1]³ is 68/81 from the
+    /// centre at every level: after one level it is a regular point with edge neighbours
+    /// at x = 3/4 and diagonal ones at the cube's corners moved to 5/9, and the mask gives
+    /// (16 + 4 · 4 · 3/4 + 4 · 5/9) / 36 = 68/81. The surface shrinks as levels grow.
     #[test]
     fn a_cube_refines_to_its_limit_surface() {
         let mut previous = f32::INFINITY;
@@ -312,7 +458,7 @@ mod tests {
                 .map(|p| p.x)
                 .fold(f32::NEG_INFINITY, f32::max);
             assert!(
-                (along_x - 5.0 / 9.0).abs() < 1e-5,
+                (along_x - 68.0 / 81.0).abs() < 1e-5,
                 "level {levels}: {along_x}"
             );
             let spread = refined
@@ -345,5 +491,104 @@ mod tests {
         assert_eq!(uvs.len(), refined.indices.len());
         let smooth = catmull_clark(&quad, Boundary::EdgeOnly, 2);
         assert!(!smooth.points.iter().any(|p| p.distance(Vec3::ZERO) < 1e-6));
+    }
+
+    fn icosahedron() -> Cage {
+        let t = (1.0 + 5f32.sqrt()) / 2.0;
+        let points: Vec<Vec3> = [
+            (-1.0, t, 0.0),
+            (1.0, t, 0.0),
+            (-1.0, -t, 0.0),
+            (1.0, -t, 0.0),
+            (0.0, -1.0, t),
+            (0.0, 1.0, t),
+            (0.0, -1.0, -t),
+            (0.0, 1.0, -t),
+            (t, 0.0, -1.0),
+            (t, 0.0, 1.0),
+            (-t, 0.0, -1.0),
+            (-t, 0.0, 1.0),
+        ]
+        .iter()
+        .map(|&(x, y, z)| Vec3::new(x, y, z).normalize())
+        .collect();
+        let faces = [
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        Cage {
+            points,
+            counts: vec![3; 20],
+            indices: faces.concat(),
+            uvs: None,
+            origin: (0..20).collect(),
+        }
+    }
+
+    /// Loop's limit of a regular icosahedron inscribed in the unit sphere: the twelve
+    /// original points (valence 5, neighbours at cos θ = 1/√5) end at radius
+    /// 1 − 5χ + 5χ/√5 from the limit mask, whatever the level (one limit point), every
+    /// level has four times the triangles, and nothing leaves the sphere.
+    #[test]
+    fn loop_refines_an_icosahedron_symmetrically_to_one_limit() {
+        let one = loop_subdivision(&icosahedron(), Boundary::EdgeAndCorner, 1);
+        let three = loop_subdivision(&icosahedron(), Boundary::EdgeAndCorner, 3);
+        assert_eq!(three.counts.len(), 20 * 64);
+        let radius = three.points[0].length();
+        for v in 0..12 {
+            assert!((three.points[v].length() - radius).abs() < 1e-5);
+            assert!(one.points[v].distance(three.points[v]) < 1e-5, "point {v}");
+        }
+        let chi = 1.0 / (3.0 / (8.0 * loop_beta(5)) + 5.0);
+        let exact = 1.0 - 5.0 * chi + 5.0 * chi / 5f32.sqrt();
+        assert!((radius - exact).abs() < 1e-5, "{radius} vs {exact}");
+        assert!(three.points.iter().all(|p| p.length() < 1.0));
+    }
+
+    /// A flat triangulated square stays flat, keeps the two corners that lie on a single
+    /// triangle with `EdgeAndCorner` (the other two are boundary points of two triangles,
+    /// smoothed like any) and carries its texture coordinates per corner.
+    #[test]
+    fn loop_keeps_a_flat_square_flat_with_its_corners() {
+        let square = Cage {
+            points: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            counts: vec![3, 3],
+            indices: vec![0, 1, 2, 0, 2, 3],
+            uvs: Some(vec![
+                Vec2::ZERO,
+                Vec2::X,
+                Vec2::ONE,
+                Vec2::ZERO,
+                Vec2::ONE,
+                Vec2::Y,
+            ]),
+            origin: vec![0, 1],
+        };
+        let refined = loop_subdivision(&square, Boundary::EdgeAndCorner, 2);
+        assert_eq!(refined.counts.len(), 32);
+        assert!(refined.points.iter().all(|p| p.z == 0.0));
+        for corner in [square.points[1], square.points[3]] {
+            assert!(refined.points.iter().any(|p| p.distance(corner) < 1e-6));
+        }
+        assert!(!refined.points.iter().any(|p| p.distance(Vec3::ZERO) < 1e-6));
+        assert_eq!(refined.uvs.unwrap().len(), 96);
     }
 }

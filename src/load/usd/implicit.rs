@@ -124,6 +124,13 @@ fn sphere_rings(r: f32, offset: f32, from: f32, to: f32, rings: usize) -> Vec<Ri
         .map(|k| {
             let phi = from + (to - from) * k as f32 / rings as f32;
             let (sin, cos) = phi.sin_cos();
+            // Exactly zero at the poles (cos(±π/2) is 4e-8 in f32), so they close as
+            // triangles.
+            let cos = if (k == 0 && from == -PI / 2.0) || (k == rings && to == PI / 2.0) {
+                0.0
+            } else {
+                cos
+            };
             Ring {
                 radius: r * cos,
                 height: offset + r * sin,

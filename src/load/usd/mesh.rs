@@ -12,7 +12,7 @@ use super::value::{Interpolation, as_bool, as_f64s, as_ints, as_token, as_vec2s,
 use crate::limits::check_memory;
 use crate::load::LoadError;
 use crate::load::polygon::{MAX_EAR_CLIPPED_CORNERS, fan, triangulate};
-use crate::load::subdivision::{Boundary, Cage, catmull_clark, refined_faces};
+use crate::load::subdivision::{Boundary, Cage, catmull_clark, loop_subdivision, refined_faces};
 use crate::load::tangents::generate_tangents;
 use crate::scene::{AlphaMode, Material, Mesh};
 
@@ -438,14 +438,21 @@ impl UsdLoader {
         }
     }
 
-    /// `polygons` refined as a Catmull–Clark surface ([`catmull_clark`]). Authored normals
+    /// `polygons` refined as a Catmull–Clark surface ([`catmull_clark`]), or a Loop one
+    /// ([`loop_subdivision`]) when all are triangles and the scheme says `loop`. Authored normals
     /// do not apply to a subdivision surface (UsdGeomMesh); the refined mesh gets smooth
     /// vertex normals. Face-varying texture coordinates are interpolated linearly, per-face
     /// data follows the face it came from, and other display colours become per face.
     fn subdivide(&mut self, path: &sdf::Path, polygons: Polygons) -> Result<Polygons, LoadError> {
         let where_ = path.as_str();
         let levels = self.subdivision_levels;
-        let faces = refined_faces(&polygons.counts, levels);
+        let scheme = self.get_token(path, "subdivisionScheme");
+        let is_loop = scheme.as_deref() == Some("loop");
+        let faces = if is_loop {
+            (polygons.counts.len() as u64).saturating_mul(4u64.saturating_pow(levels))
+        } else {
+            refined_faces(&polygons.counts, levels)
+        };
         // Each refined quad: four corners, a point, texture coordinates, triangles later.
         check_memory(
             || format!("{where_}: subdivision to level {levels}"),
@@ -486,7 +493,11 @@ impl UsdLoader {
             uvs,
             origin: (0..polygons.counts.len()).collect(),
         };
-        let refined = catmull_clark(&cage, boundary, levels);
+        let refined = if is_loop {
+            loop_subdivision(&cage, boundary, levels)
+        } else {
+            catmull_clark(&cage, boundary, levels)
+        };
         let per_face = |values: &Option<(Vec<Vec3>, Interpolation)>| {
             values.as_ref().map(|v| match v.1 {
                 Interpolation::Constant | Interpolation::Uniform => v.clone(),
@@ -559,10 +570,15 @@ impl UsdLoader {
                 self.subdivide(prim.path(), polygons)?
             }
             Some("loop") if self.subdivision_levels > 0 => {
-                self.warn(format!(
-                    "{where_}: Loop subdivision is not supported; rendered as its control cage"
-                ));
-                polygons
+                if polygons.counts.iter().all(|&c| c == 3) {
+                    self.subdivide(prim.path(), polygons)?
+                } else {
+                    self.warn(format!(
+                        "{where_}: Loop subdivision needs triangles, and this mesh has other \
+                         polygons; rendered as its control cage"
+                    ));
+                    polygons
+                }
             }
             _ => polygons,
         };
