@@ -2,12 +2,15 @@
 //! library computes for the same stages (`tools/make_usd_pipeline.py` writes both: the
 //! stages under `tests/scenes/usd_pipeline/` and a JSON file of answers beside each).
 
+mod world;
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use gridtrace::load::{LoadOptions, Loaded, load_scene, load_scene_with};
 use gridtrace::scene::{AlphaMode, Material, Scene};
 use serde_json::Value;
+use world::{farthest, mesh_points};
 
 const DIR: &str = "tests/scenes/usd_pipeline";
 
@@ -351,32 +354,6 @@ fn blender_glass_from_usd_with_materialx_is_the_gltf_glass() {
     assert!(usd.pbr.base_colour.abs_diff_eq(gltf.pbr.base_colour, 1e-6));
 }
 
-/// Points of the mesh named `prim`, in world space.
-fn world_points(scene: &Scene, prim: &str) -> Vec<glam::Vec3> {
-    scene
-        .instances
-        .iter()
-        .filter(|i| scene.meshes[i.mesh].name == prim)
-        .flat_map(|i| {
-            scene.meshes[i.mesh]
-                .positions
-                .iter()
-                .map(|&p| i.world_from_object.transform_point3(p))
-        })
-        .collect()
-}
-
-/// The farthest any point of `a` is from the nearest point of `b`.
-fn farthest_from(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
-    a.iter()
-        .map(|p| {
-            b.iter()
-                .map(|q| p.distance(*q))
-                .fold(f32::INFINITY, f32::min)
-        })
-        .fold(0.0, f32::max)
-}
-
 /// Blender's Subdivision modifier exported as its cage (`catmullClark`, `edgeOnly`
 /// boundaries) is refined by gridtrace to the surface Blender itself exports with the
 /// modifier applied at its render level: every point of either within 1 mm of a point of
@@ -390,13 +367,10 @@ fn blender_subdivision_cage_refines_to_blenders_own_surface() {
     let applied = load_clean(&Path::new(DIR).join("subdivision_applied.usda"));
     for (object, tolerance) in [("Cube", 1e-3), ("Cylinder", 1e-3), ("Grid", 2e-3)] {
         let prim = format!("/root/{object}/{object}");
-        let ours = world_points(&cage.scene, &prim);
-        let blender = world_points(&applied.scene, &prim);
+        let ours = mesh_points(&cage.scene, &prim);
+        let blender = mesh_points(&applied.scene, &prim);
         assert!(!ours.is_empty() && !blender.is_empty(), "{prim}");
-        let (there, back) = (
-            farthest_from(&blender, &ours),
-            farthest_from(&ours, &blender),
-        );
+        let (there, back) = (farthest(&blender, &ours), farthest(&ours, &blender));
         assert!(
             there < tolerance && back < tolerance,
             "{prim}: Blender's points up to {there} m from ours, ours up to {back} m from Blender's"
@@ -410,9 +384,9 @@ fn blender_subdivision_cage_refines_to_blenders_own_surface() {
     let unrefined =
         load_scene_with(&Path::new(DIR).join("subdivision_cage.usda"), &options).unwrap();
     let cube = "/root/Cube/Cube";
-    let far = farthest_from(
-        &world_points(&unrefined.scene, cube),
-        &world_points(&applied.scene, cube),
+    let far = farthest(
+        &mesh_points(&unrefined.scene, cube),
+        &mesh_points(&applied.scene, cube),
     );
     assert!(far > 0.05, "{far}");
 }
@@ -447,34 +421,28 @@ fn blender_armature_animation_is_skinned_as_usd_and_blender_pose_it() {
         };
         let loaded = load_scene_with(&Path::new(DIR).join("skinned.usdc"), &options).unwrap();
         assert!(loaded.warnings.is_empty(), "{:#?}", loaded.warnings);
-        let ours = world_points(&loaded.scene, prim);
+        let ours = mesh_points(&loaded.scene, prim);
         let usd: Vec<glam::Vec3> = baked[prim][frame.to_string()]
             .as_array()
             .unwrap()
             .iter()
             .map(y_up)
             .collect();
-        let (there, back) = (farthest_from(&usd, &ours), farthest_from(&ours, &usd));
+        let (there, back) = (farthest(&usd, &ours), farthest(&ours, &usd));
         assert!(
             there < 1e-4 && back < 1e-4,
             "frame {frame}: usd-core's baked points up to {there} m from ours, ours {back} m"
         );
         let blender = load_clean(&Path::new(DIR).join(format!("skinned_frame_{frame}.usdc")));
-        let blender = world_points(&blender.scene, prim);
-        let (there, back) = (
-            farthest_from(&blender, &ours),
-            farthest_from(&ours, &blender),
-        );
+        let blender = mesh_points(&blender.scene, prim);
+        let (there, back) = (farthest(&blender, &ours), farthest(&ours, &blender));
         assert!(
             there < 1e-3 && back < 1e-3,
             "frame {frame}: Blender's posed points up to {there} m from ours, ours {back} m"
         );
         if frame != 1 {
-            let rest = world_points(&unposed.scene, prim);
-            assert!(
-                farthest_from(&ours, &rest) > 0.1,
-                "frame {frame} is not posed"
-            );
+            let rest = mesh_points(&unposed.scene, prim);
+            assert!(farthest(&ours, &rest) > 0.1, "frame {frame} is not posed");
         }
     }
 }

@@ -26,6 +26,44 @@ pub fn world_triangles(scene: &Scene) -> Vec<[[f32; 3]; 3]> {
     triangles
 }
 
+/// The triangles of the instances whose source is `source`, in world space, in order.
+pub fn source_triangles(scene: &Scene, source: &str) -> Vec<[Vec3; 3]> {
+    scene
+        .instances
+        .iter()
+        .filter(|i| i.source == source)
+        .flat_map(|inst| {
+            let mesh = &scene.meshes[inst.mesh];
+            mesh.indices.iter().map(move |t| {
+                t.map(|v| {
+                    inst.world_from_object
+                        .transform_point3(mesh.positions[v as usize])
+                })
+            })
+        })
+        .collect()
+}
+
+/// The points of every instance of the mesh named `name`, in world space.
+pub fn mesh_points(scene: &Scene, name: &str) -> Vec<Vec3> {
+    scene
+        .instances
+        .iter()
+        .filter(|i| scene.meshes[i.mesh].name == name)
+        .flat_map(|i| {
+            scene.meshes[i.mesh]
+                .positions
+                .iter()
+                .map(|&p| i.world_from_object.transform_point3(p))
+        })
+        .collect()
+}
+
+/// Two points equal within 10⁻⁵ in every coordinate.
+pub fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).abs().max_element() < 1e-5
+}
+
 /// Every corner of every triangle.
 pub fn corners(triangles: &[[[f32; 3]; 3]]) -> Vec<Vec3> {
     triangles.iter().flatten().map(|&p| Vec3::from(p)).collect()
