@@ -334,9 +334,7 @@ fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
         uvs: mesh.uvs.as_ref().map(|_| Vec::new()),
         ..Cage::default()
     };
-    for f in 0..mesh.counts.len() {
-        let count = mesh.counts[f];
-        let start = starts[f];
+    for (f, (&count, &start)) in mesh.counts.iter().zip(&starts).enumerate() {
         let face_uv = mesh
             .uvs
             .as_ref()

@@ -79,7 +79,7 @@ impl UsdLoader {
                 continue;
             }
             let rel = at
-                .append_property(&format!("{collection_prefix}{name}"))
+                .append_property(format!("{collection_prefix}{name}"))
                 .ok()?;
             let targets = self.stage.relationship(rel.clone()).targets().ok()?;
             let [collection, material] = targets.as_slice() else {
@@ -89,7 +89,7 @@ impl UsdLoader {
                 return Some((material.clone(), self.stronger(&rel)));
             }
         }
-        let rel = at.append_property(&suffix("material:binding")).ok()?;
+        let rel = at.append_property(suffix("material:binding")).ok()?;
         let material = self
             .stage
             .relationship(rel.clone())
