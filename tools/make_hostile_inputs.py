@@ -89,6 +89,27 @@ def Material "Glow"
 """
 
 
+def textured_material(name, file):
+    """A UsdPreviewSurface material `name` whose diffuse colour reads the image `file`."""
+    return f"""def Material "{name}"
+{{
+    token outputs:surface.connect = </{name}/Surface.outputs:surface>
+    def Shader "Surface"
+    {{
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor.connect = </{name}/Image.outputs:rgb>
+        token outputs:surface
+    }}
+    def Shader "Image"
+    {{
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @{file}@
+        float3 outputs:rgb
+    }}
+}}
+"""
+
+
 def usda(body="", metadata=""):
     return f"#usda 1.0\n(\n    upAxis = \"Y\"\n{metadata})\n\n{USDA_QUAD}{body}"
 
@@ -283,44 +304,11 @@ def Xform "B" (
     point3f[] positions = [(0, 0, 0), (3, 0, 0)]
 }
 """))
-    root = usda("""def Material "Odd"
-{
-    token outputs:surface.connect = </Odd/Surface.outputs:surface>
-    def Shader "Surface"
-    {
-        uniform token info:id = "UsdPreviewSurface"
-        color3f inputs:diffuseColor.connect = </Odd/Image.outputs:rgb>
-        token outputs:surface
-    }
-    def Shader "Image"
-    {
-        uniform token info:id = "UsdUVTexture"
-        asset inputs:file = @../escape.png@
-        float3 outputs:rgb
-    }
-}
-""").replace("</Glow>", "</Odd>", 1)
+    root = usda(textured_material("Odd", "../escape.png")).replace("</Glow>", "</Odd>", 1)
     with zipfile.ZipFile(j("usdz_odd_members.usdz"), "w", zipfile.ZIP_STORED) as z:
         z.writestr("root.usda", root)
         z.writestr("../escape.png", b"not an image")
         z.writestr("/absolute.png", b"not an image")
-    bomb = usda("""def Material "Bomb"
-{
-    token outputs:surface.connect = </Bomb/Surface.outputs:surface>
-    def Shader "Surface"
-    {
-        uniform token info:id = "UsdPreviewSurface"
-        color3f inputs:diffuseColor.connect = </Bomb/Image.outputs:rgb>
-        token outputs:surface
-    }
-    def Shader "Image"
-    {
-        uniform token info:id = "UsdUVTexture"
-        asset inputs:file = @big.png@
-        float3 outputs:rgb
-    }
-}
-""").replace("</Glow>", "</Bomb>", 1)
     write(j("usd_skel_bad_index.usda"), usda("""def SkelRoot "Rig"
 {
     def Skeleton "Skeleton" (
@@ -350,6 +338,7 @@ def Xform "B" (
     }
 }
 """))
+    bomb = usda(textured_material("Bomb", "big.png")).replace("</Glow>", "</Bomb>", 1)
     # 2.5 GiB of zeros deflated to a few megabytes: past the 2 GiB the test allows.
     write_deflate_bomb(j("usdz_deflate_bomb.usdz"), bomb, 5 << 29)
 

@@ -66,19 +66,21 @@ def shape_keys():
     key(bump, "value", 24, 0.3)
 
 
-def armature():
-    # Open (no caps, whose subdivided fans would hold zero-area triangles).
+def skinned_column(name, location, vertices, cuts):
+    """An open column 2 m tall standing at `location` (no caps, whose subdivided fans would
+    hold zero-area triangles), `cuts` rings along its height so a bend is smooth, skinned
+    with automatic weights to an armature "Rig" of two bones, Lower and Upper."""
+    x, y, z = location
     bpy.ops.mesh.primitive_cylinder_add(
-        vertices=12, radius=0.2, depth=2.0, end_fill_type="NOTHING", location=(2.0, 0.0, 1.0)
+        vertices=vertices, radius=0.2, depth=2.0, end_fill_type="NOTHING", location=(x, y, z + 1.0)
     )
     tube = bpy.context.active_object
-    tube.name = "Tube"
-    # Rings along the height so the bend is smooth.
+    tube.name = name
     bpy.ops.object.mode_set(mode="EDIT")
     bpy.ops.mesh.select_all(action="SELECT")
-    bpy.ops.mesh.subdivide(number_cuts=8)
+    bpy.ops.mesh.subdivide(number_cuts=cuts)
     bpy.ops.object.mode_set(mode="OBJECT")
-    bpy.ops.object.armature_add(location=(2.0, 0.0, 0.0))
+    bpy.ops.object.armature_add(location=location)
     rig = bpy.context.active_object
     rig.name = "Rig"
     bpy.ops.object.mode_set(mode="EDIT")
@@ -95,6 +97,11 @@ def armature():
     rig.select_set(True)
     bpy.context.view_layer.objects.active = rig
     bpy.ops.object.parent_set(type="ARMATURE_AUTO")
+    return tube, rig
+
+
+def armature():
+    _, rig = skinned_column("Tube", (2.0, 0.0, 0.0), vertices=12, cuts=8)
     bone = rig.pose.bones["Upper"]
     bone.rotation_mode = "XYZ"
     key(bone, "rotation_euler", 1, (0.0, 0.0, 0.0))
@@ -162,4 +169,5 @@ def main():
                 obj.modifiers.new(modifier_name, "ARMATURE").object = rig
 
 
-main()
+if __name__ == "__main__":
+    main()

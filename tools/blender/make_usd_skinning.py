@@ -12,6 +12,9 @@ import sys
 
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_gltf_animation import skinned_column  # noqa: E402
+
 FRAMES = (1, 9, 17)
 
 
@@ -19,35 +22,7 @@ def build():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 17
-    bpy.ops.mesh.primitive_cylinder_add(
-        vertices=8, radius=0.2, depth=2.0, location=(0, 0, 1), end_fill_type="NOTHING"
-    )
-    column = bpy.context.active_object
-    column.name = "Column"
-    # Rings along the height so the bend has vertices to move.
-    bpy.ops.object.mode_set(mode="EDIT")
-    bpy.ops.mesh.select_all(action="SELECT")
-    bpy.ops.mesh.subdivide(number_cuts=6)
-    bpy.ops.object.mode_set(mode="OBJECT")
-
-    bpy.ops.object.armature_add(location=(0, 0, 0))
-    rig = bpy.context.active_object
-    rig.name = "Rig"
-    bpy.ops.object.mode_set(mode="EDIT")
-    lower = rig.data.edit_bones[0]
-    lower.name = "Lower"
-    lower.head, lower.tail = (0, 0, 0), (0, 0, 1)
-    upper = rig.data.edit_bones.new("Upper")
-    upper.head, upper.tail = (0, 0, 1), (0, 0, 2)
-    upper.parent = lower
-    upper.use_connect = True
-    bpy.ops.object.mode_set(mode="OBJECT")
-
-    column.select_set(True)
-    rig.select_set(True)
-    bpy.context.view_layer.objects.active = rig
-    bpy.ops.object.parent_set(type="ARMATURE_AUTO")
-
+    _, rig = skinned_column("Column", (0.0, 0.0, 0.0), vertices=8, cuts=6)
     bpy.ops.object.mode_set(mode="POSE")
     for frame, bend in ((1, 0.0), (9, 50.0), (17, -30.0)):
         scene.frame_set(frame)
