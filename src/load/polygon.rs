@@ -1,4 +1,4 @@
-//! Polygons with more than three corners (USD faces) split into triangles.
+//! Polygons with more than three corners (USD and PLY faces) split into triangles.
 
 use glam::{Vec2, Vec3};
 
@@ -28,7 +28,19 @@ pub fn triangulate(polygon: &[Vec3]) -> Option<Vec<[usize; 3]>> {
         );
     }
     let convex_at = |a: Vec3, b: Vec3, c: Vec3| (b - a).cross(c - b).dot(normal) >= 0.0;
-    if n == 3 || (0..n).all(|i| convex_at(polygon[i], polygon[(i + 1) % n], polygon[(i + 2) % n])) {
+    let convex = (0..n).all(|i| convex_at(polygon[i], polygon[(i + 1) % n], polygon[(i + 2) % n]));
+    if n == 4 && convex {
+        // A convex quad splits along its shorter diagonal: the closer fit to a curved
+        // (non-planar) quad, and the same split whichever corner the quad starts at.
+        let short_02 =
+            polygon[0].distance_squared(polygon[2]) <= polygon[1].distance_squared(polygon[3]);
+        return Some(if short_02 {
+            vec![[0, 1, 2], [0, 2, 3]]
+        } else {
+            vec![[1, 2, 3], [1, 3, 0]]
+        });
+    }
+    if n == 3 || convex {
         return Some(fan(n));
     }
     if n > MAX_EAR_CLIPPED_CORNERS {

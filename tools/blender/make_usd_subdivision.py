@@ -5,11 +5,12 @@ on). gridtrace refines the first; `tests/usd_pipeline.rs` compares it with the s
 
     /tmp/bpyenv/bin/python tools/blender/make_usd_subdivision.py tests/scenes/usd_pipeline
 
-Objects: a cube (every vertex of valence 3), a capped cylinder (n-gon caps, valence 3 and
+Objects (seen by a camera, lit by a sun): a cube (every vertex of valence 3), a capped cylinder (n-gon caps, valence 3 and
 4), and a grid with an open boundary (corners kept, as USD's edgeAndCorner default), each
 with a Subdivision modifier at Blender's defaults (render level 2).
 """
 
+import math
 import os
 import sys
 
@@ -17,6 +18,9 @@ import bpy
 
 
 def subdivided(obj):
+    # Smooth shading, as subdivision surfaces are modelled: a flat-shaded object keeps its
+    # facets through Blender's modifier, while a USD subdivision surface is smooth.
+    bpy.ops.object.shade_smooth()
     modifier = obj.modifiers.new("Subdivision", "SUBSURF")
     modifier.levels = 1
     modifier.render_levels = 2
@@ -33,6 +37,10 @@ def build():
     grid = subdivided(bpy.context.active_object)
     grid.name = "Grid"
     grid.data.vertices[4].co.z = 0.4
+    bpy.ops.object.camera_add(location=(0.0, -6.0, 3.0), rotation=(math.radians(65), 0.0, 0.0))
+    bpy.context.scene.camera = bpy.context.active_object
+    bpy.ops.object.light_add(type="SUN", rotation=(math.radians(35), math.radians(25), 0.0))
+    bpy.context.active_object.data.energy = 3.0
 
 
 def main():

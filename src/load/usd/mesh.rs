@@ -70,12 +70,14 @@ fn repose_normals(polygons: &mut Polygons, posed: &[Vec3]) {
     polygons.normals = Some((turned, Interpolation::FaceVarying));
 }
 
-/// Area-weighted point normals of a polygon mesh (each face's corners' cross products).
+/// Point normals of a polygon mesh, each face's normal weighted by its corner angle at the
+/// point (Thürmer & Wüthrich 1998; what Blender computes for smooth-shaded meshes).
 fn smooth_normals(polygons: &Polygons) -> Vec<Vec3> {
     let mut normals = vec![Vec3::ZERO; polygons.points.len()];
     let mut start = 0;
     for &count in &polygons.counts {
         let corners = &polygons.indices[start..start + count];
+        let face = face_normal(&polygons.points, corners).normalize_or_zero();
         for i in 0..count {
             let [a, b, c] = [
                 corners[(i + count - 1) % count],
@@ -83,7 +85,7 @@ fn smooth_normals(polygons: &Polygons) -> Vec<Vec3> {
                 corners[(i + 1) % count],
             ];
             let p = &polygons.points;
-            normals[b] += (p[c] - p[b]).cross(p[a] - p[b]);
+            normals[b] += face * (p[c] - p[b]).angle_between(p[a] - p[b]);
         }
         start += count;
     }
