@@ -519,3 +519,64 @@ fn blender_subdivision_cage_renders_like_blenders_own_surface() {
         &blender,
     );
 }
+
+/// A subdivision surface keeps its display colours: per-point colours become per face (each
+/// refined face takes its cage face's first corner's colour), so every triangle is one of
+/// the authored colours throughout.
+#[test]
+fn subdivided_display_colours_follow_their_cage_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("coloured.usda");
+    std::fs::write(
+        &path,
+        r#"#usda 1.0
+(
+    upAxis = "Y"
+    metersPerUnit = 1
+)
+def Mesh "Box"
+{
+    int[] faceVertexCounts = [4, 4, 4, 4, 4, 4]
+    int[] faceVertexIndices = [0, 4, 6, 2, 1, 3, 7, 5, 0, 1, 5, 4, 2, 6, 7, 3, 0, 2, 3, 1, 4, 5, 7, 6]
+    point3f[] points = [(-1, -1, -1), (1, -1, -1), (-1, 1, -1), (1, 1, -1), (-1, -1, 1), (1, -1, 1), (-1, 1, 1), (1, 1, 1)]
+    color3f[] primvars:displayColor = [(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (0, 1, 1), (1, 0, 1), (1, 1, 1), (0, 0, 0)] (
+        interpolation = "vertex"
+    )
+    uniform token subdivisionScheme = "catmullClark"
+}
+"#,
+    )
+    .unwrap();
+    let loaded = load_clean(&path);
+    let mesh = loaded
+        .scene
+        .meshes
+        .iter()
+        .find(|m| m.name == "/Box")
+        .unwrap();
+    assert_eq!(mesh.indices.len(), 6 * 16 * 2);
+    let authored: BTreeSet<[u32; 3]> = [
+        [1, 0, 0],
+        [0, 1, 0],
+        [0, 0, 1],
+        [1, 1, 0],
+        [0, 1, 1],
+        [1, 0, 1],
+        [1, 1, 1],
+        [0, 0, 0],
+    ]
+    .into_iter()
+    .collect();
+    let mut seen = BTreeSet::new();
+    for t in &mesh.indices {
+        let [a, b, c] = t.map(|i| mesh.colours[i as usize]);
+        assert!(a == b && b == c);
+        seen.insert([a.x, a.y, a.z].map(|v| v as u32));
+    }
+    // The first corners of the six faces: points 0, 1, 0, 2, 0, 4.
+    let firsts: BTreeSet<[u32; 3]> = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 1, 1]]
+        .into_iter()
+        .collect();
+    assert_eq!(seen, firsts);
+    assert!(seen.is_subset(&authored));
+}

@@ -503,10 +503,18 @@ impl UsdLoader {
         let per_face = |values: &Option<(Vec<Vec3>, Interpolation)>| {
             values.as_ref().map(|v| match v.1 {
                 Interpolation::Constant | Interpolation::Uniform => v.clone(),
+                // Each face takes the value at its first corner.
                 _ => (
-                    (0..polygons.counts.len())
-                        .map(|f| {
-                            let first = polygons.counts[..f].iter().sum::<usize>();
+                    polygons
+                        .counts
+                        .iter()
+                        .scan(0, |first, &count| {
+                            let corner = *first;
+                            *first += count;
+                            Some(corner)
+                        })
+                        .enumerate()
+                        .map(|(f, first)| {
                             pick(v, first, f, polygons.indices[first]).unwrap_or(Vec3::ONE)
                         })
                         .collect(),
