@@ -130,6 +130,10 @@ const CASES: &[(&str, Expect)] = &[
         Expect::Warning("composition arc cycle at /Ref"),
     ),
     (
+        "usd_missing_reference.usda",
+        Expect::Warning("not_there.usda@ at /Ref; its content is left out"),
+    ),
+    (
         "usd_internal_cycle.usda",
         Expect::Warning("composition arc cycle at /A"),
     ),

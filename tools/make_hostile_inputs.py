@@ -263,6 +263,8 @@ def Mesh "Floor"
     write(j("cycle_b.usda"), usda(metadata="    subLayers = [@usd_sublayer_cycle.usda@]\n"))
     write(j("usd_self_reference.usda"),
           usda("def Xform \"Ref\" (\n    prepend references = @usd_self_reference.usda@</Ref>\n)\n{\n}\n"))
+    write(j("usd_missing_reference.usda"),
+          usda("def Xform \"Ref\" (\n    prepend references = @not_there.usda@\n)\n{\n}\n"))
     write(j("usd_internal_cycle.usda"), usda("""def Xform "A" (
     prepend references = </B>
 )
