@@ -32,6 +32,15 @@ fn load_clean(path: &Path) -> Loaded {
     loaded
 }
 
+/// `body` as a Y-up, metre stage in a new temporary folder (kept while the folder lives).
+fn write_stage(body: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stage.usda");
+    let header = "#usda 1.0\n(\n    upAxis = \"Y\"\n    metersPerUnit = 1\n)\n";
+    std::fs::write(&path, format!("{header}{body}")).unwrap();
+    (dir, path)
+}
+
 /// The material of the mesh named `prim`, without the one-sided suffix in its name.
 fn material_of<'a>(scene: &'a Scene, prim: &str) -> &'a Material {
     let mesh = scene
@@ -455,16 +464,8 @@ fn blender_armature_animation_is_skinned_as_usd_and_blender_pose_it() {
 /// cage with a warning naming it.
 #[test]
 fn loop_subdivision_refines_triangle_meshes_to_the_level_asked_for() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("loop.usda");
-    std::fs::write(
-        &path,
-        r#"#usda 1.0
-(
-    upAxis = "Y"
-    metersPerUnit = 1
-)
-def Mesh "Tetra"
+    let (_dir, path) = write_stage(
+        r#"def Mesh "Tetra"
 {
     int[] faceVertexCounts = [3, 3, 3, 3]
     int[] faceVertexIndices = [0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2]
@@ -479,8 +480,7 @@ def Mesh "Quad"
     uniform token subdivisionScheme = "loop"
 }
 "#,
-    )
-    .unwrap();
+    );
     for levels in [0u32, 1, 3] {
         let options = LoadOptions {
             subdivision_level: Some(levels),
@@ -525,16 +525,8 @@ fn blender_subdivision_cage_renders_like_blenders_own_surface() {
 /// the authored colours throughout.
 #[test]
 fn subdivided_display_colours_follow_their_cage_faces() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("coloured.usda");
-    std::fs::write(
-        &path,
-        r#"#usda 1.0
-(
-    upAxis = "Y"
-    metersPerUnit = 1
-)
-def Mesh "Box"
+    let (_dir, path) = write_stage(
+        r#"def Mesh "Box"
 {
     int[] faceVertexCounts = [4, 4, 4, 4, 4, 4]
     int[] faceVertexIndices = [0, 4, 6, 2, 1, 3, 7, 5, 0, 1, 5, 4, 2, 6, 7, 3, 0, 2, 3, 1, 4, 5, 7, 6]
@@ -545,8 +537,7 @@ def Mesh "Box"
     uniform token subdivisionScheme = "catmullClark"
 }
 "#,
-    )
-    .unwrap();
+    );
     let loaded = load_clean(&path);
     let mesh = loaded
         .scene

@@ -286,28 +286,24 @@ fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
         vertex_edges[*a].push(e);
         vertex_edges[*b].push(e);
     }
+    let (_, border, faces) = neighbours(mesh, &edges);
     let vertex_points: Vec<Vec3> = (0..n)
         .map(|v| {
             let p = mesh.points[v];
             let incident = &vertex_edges[v];
-            let border: Vec<usize> = incident
-                .iter()
-                .copied()
-                .filter(|&e| is_boundary(e))
-                .collect();
             if incident.is_empty() {
                 return p;
             }
-            if !border.is_empty() {
-                let corner = vertex_faces[v].len() == 1 && boundary == Boundary::EdgeAndCorner;
-                if border.len() != 2 || corner {
-                    return p;
-                }
-                let other = |e: usize| {
-                    let [a, b] = edges.ends[e];
-                    mesh.points[if a == v { b } else { a }]
-                };
-                return 0.75 * p + 0.125 * (other(border[0]) + other(border[1]));
+            if !border[v].is_empty() {
+                return boundary_rule(
+                    &mesh.points,
+                    v,
+                    &border[v],
+                    faces[v],
+                    boundary,
+                    (0.125, 0.75),
+                )
+                .unwrap_or(p);
             }
             let valence = incident.len() as f32;
             let f = vertex_faces[v]
@@ -370,44 +366,26 @@ fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
 /// B-spline's `(e₀ + 4 p + e₁) / 6`; corners stay.
 fn limit_positions(mesh: &Cage, boundary: Boundary) -> Vec<Vec3> {
     let edges = edges(mesh);
-    let n = mesh.points.len();
-    let mut edge_sum = vec![Vec3::ZERO; n];
-    let mut valence = vec![0usize; n];
-    let mut border = vec![Vec::new(); n];
-    for (e, &[a, b]) in edges.ends.iter().enumerate() {
-        edge_sum[a] += mesh.points[b];
-        edge_sum[b] += mesh.points[a];
-        valence[a] += 1;
-        valence[b] += 1;
-        if edges.faces[e].len() != 2 {
-            border[a].push(b);
-            border[b].push(a);
-        }
-    }
-    let mut diagonal_sum = vec![Vec3::ZERO; n];
-    let mut faces = vec![0usize; n];
+    let (ring, border, faces) = neighbours(mesh, &edges);
+    let p = &mesh.points;
+    let mut diagonal_sum = vec![Vec3::ZERO; p.len()];
     for quad in mesh.indices.chunks(4) {
         for i in 0..4 {
-            diagonal_sum[quad[i]] += mesh.points[quad[(i + 2) % 4]];
-            faces[quad[i]] += 1;
+            diagonal_sum[quad[i]] += p[quad[(i + 2) % 4]];
         }
     }
-    (0..n)
+    (0..p.len())
         .map(|v| {
-            let p = mesh.points[v];
-            if valence[v] == 0 {
-                return p;
+            if ring[v].is_empty() {
+                return p[v];
             }
             if !border[v].is_empty() {
-                let corner = faces[v] == 1 && boundary == Boundary::EdgeAndCorner;
-                if border[v].len() != 2 || corner {
-                    return p;
-                }
-                let [a, b] = [border[v][0], border[v][1]];
-                return (mesh.points[a] + 4.0 * p + mesh.points[b]) / 6.0;
+                return boundary_rule(p, v, &border[v], faces[v], boundary, (1.0 / 6.0, 4.0 / 6.0))
+                    .unwrap_or(p[v]);
             }
-            let k = valence[v] as f32;
-            (k * k * p + 4.0 * edge_sum[v] + diagonal_sum[v]) / (k * (k + 5.0))
+            let k = ring[v].len() as f32;
+            let edge_sum: Vec3 = ring[v].iter().map(|&u| p[u]).sum();
+            (k * k * p[v] + 4.0 * edge_sum + diagonal_sum[v]) / (k * (k + 5.0))
         })
         .collect()
 }

@@ -41,7 +41,7 @@ impl UsdLoader {
             return Ok(None);
         };
         let where_ = path.as_str().to_string();
-        match self.pose(&binding, &skeleton_path, points, &where_) {
+        match self.pose(&binding, &skeleton_path, points, &path) {
             Ok(posed) => {
                 let world = self.world_transform(&skeleton_path)?;
                 Ok(Some((posed, world)))
@@ -61,7 +61,7 @@ impl UsdLoader {
         binding: &SkelBindingAPI,
         skeleton_path: &sdf::Path,
         points: &[Vec3],
-        where_: &str,
+        prim: &sdf::Path,
     ) -> Result<Vec<Vec3>, String> {
         let skeleton = Skeleton::get(&self.stage, skeleton_path.clone())
             .ok()
@@ -84,7 +84,7 @@ impl UsdLoader {
             resolver.compute_skinning_transforms_from_local(&local, gf::Matrix4d::IDENTITY);
         let query = SkinningResolver::from_binding(binding, resolver.joint_order())
             .map_err(|e| format!("{e:#}"))?;
-        self.check_influences(&query, points.len(), where_)?;
+        self.check_influences(&query, points.len(), prim)?;
         if query.is_rigidly_deformed() {
             let rigid = to_mat4(&query.compute_rigid_transform(&skinning));
             return Ok(points.iter().map(|&p| rigid.transform_point3(p)).collect());
@@ -140,16 +140,15 @@ impl UsdLoader {
         &self,
         query: &SkinningResolver,
         points: usize,
-        where_: &str,
+        prim: &sdf::Path,
     ) -> Result<(), String> {
-        let path = sdf::Path::new(where_).map_err(|e| format!("{e:#}"))?;
         let indices = self
-            .get(&path, "primvars:skel:jointIndices")
+            .get(prim, "primvars:skel:jointIndices")
             .as_ref()
             .and_then(as_ints)
             .unwrap_or_default();
         let weights = self
-            .get(&path, "primvars:skel:jointWeights")
+            .get(prim, "primvars:skel:jointWeights")
             .as_ref()
             .and_then(super::value::as_f64s)
             .unwrap_or_default();
