@@ -18,7 +18,7 @@ use sha2::{Digest, Sha256};
 pub const RECORD_ATTRIBUTE: &str = "gridtrace/record";
 
 /// The provenance of one rendered image.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RenderRecord {
     /// The identity of the render: two images are parts of the same render when equal.
     pub identity: RenderIdentity,
@@ -32,7 +32,7 @@ pub struct RenderRecord {
 
 /// Everything that decides which value a given sample of a given pixel takes. Parts with the
 /// same identity and disjoint sample ranges add up to one render.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RenderIdentity {
     /// gridtrace's version: another version may trace the same sample differently.
     pub version: String,
@@ -52,6 +52,8 @@ pub struct RenderIdentity {
     pub max_depth: u32,
     /// Loader options that change the scene, as text (glTF light units, USD frame).
     pub load_options: String,
+    /// `--exposure` in stops, applied to every output: parts merge only at equal exposure.
+    pub exposure: f32,
 }
 
 /// Why a header does not hold a record.
@@ -89,7 +91,7 @@ impl RenderIdentity {
     }
 
     /// The identity as (attribute name, text) pairs, in a fixed order.
-    fn fields(&self) -> [(&'static str, String); 9] {
+    fn fields(&self) -> [(&'static str, String); 10] {
         [
             ("version", self.version.clone()),
             ("sceneSha256", self.scene_sha256.clone()),
@@ -100,6 +102,7 @@ impl RenderIdentity {
             ("seed", self.seed.to_string()),
             ("maxDepth", self.max_depth.to_string()),
             ("loadOptions", self.load_options.clone()),
+            ("exposure", self.exposure.to_string()),
         ]
     }
 }
@@ -166,6 +169,17 @@ impl RenderRecord {
                 seed: number("seed")?,
                 max_depth: small("maxDepth")?,
                 load_options: text("loadOptions")?,
+                // Records from before --exposure had none: 0 stops.
+                exposure: match text("exposure") {
+                    Err(_) => 0.0,
+                    Ok(value) => value.parse::<f32>().ok().filter(|v| v.is_finite()).ok_or(
+                        RecordError::Malformed {
+                            key: "exposure",
+                            value,
+                            expected: "a number of stops",
+                        },
+                    )?,
+                },
             },
             scene_name: text("scene")?,
             samples,
@@ -302,6 +316,7 @@ mod tests {
                 seed: u64::MAX,
                 max_depth: 16,
                 load_options: "gltf-light-units=standard".into(),
+                exposure: -1.5,
             },
             scene_name: "box.glb".into(),
             samples: 64..128,

@@ -253,6 +253,8 @@ fn help_explains_every_option() {
         "--fstop",
         "--focus-distance",
         "--filter",
+        "--exposure",
+        "--view-transform",
     ] {
         assert!(help.contains(option), "--help lacks {option}:\n{help}");
     }

@@ -12,7 +12,7 @@ use binary::gridtrace;
 
 use gridtrace::load::load_scene;
 use gridtrace::merge::{MERGE_TOLERANCE, MergeError, merge_files, read_part};
-use gridtrace::output::{write_image, write_image_with_record};
+use gridtrace::output::{ViewTransform, write_image, write_image_with_record};
 use gridtrace::record::{RenderIdentity, RenderRecord};
 use gridtrace::render::{Image, RenderSettings, Renderer};
 use gridtrace::scene::Camera;
@@ -36,6 +36,7 @@ fn record(samples: Range<u32>, seed: u64) -> RenderRecord {
             seed,
             max_depth: 8,
             load_options: String::new(),
+            exposure: 0.0,
         },
         scene_name: "cornell_box.glb".into(),
         samples,
@@ -92,7 +93,13 @@ fn merged_parts_equal_one_render_for_one_two_and_four_parts() {
             let path = dir
                 .path()
                 .join(format!("part-{}-{}.exr", range.start, range.end));
-            write_image_with_record(&path, &part, Some(&record(range, 3))).unwrap();
+            write_image_with_record(
+                &path,
+                &part,
+                Some(&record(range, 3)),
+                ViewTransform::Standard,
+            )
+            .unwrap();
             paths.push(path);
         }
         let (merged, merged_record) = merge_files(&paths, Some(0..SPP)).unwrap();
@@ -124,7 +131,7 @@ fn part(dir: &Path, name: &str, record: RenderRecord) -> PathBuf {
     image.spp = record.samples.end - record.samples.start;
     image.first_sample = record.samples.start;
     let path = dir.join(name);
-    write_image_with_record(&path, &image, Some(&record)).unwrap();
+    write_image_with_record(&path, &image, Some(&record), ViewTransform::Standard).unwrap();
     path
 }
 
@@ -190,7 +197,13 @@ fn bad_part_sets_are_refused_naming_the_parts() {
     nan.pixels[5].y = f32::NAN;
     nan.spp = 8;
     let damaged = d.join("damaged.exr");
-    write_image_with_record(&damaged, &nan, Some(&record(0..8, 1))).unwrap();
+    write_image_with_record(
+        &damaged,
+        &nan,
+        Some(&record(0..8, 1)),
+        ViewTransform::Standard,
+    )
+    .unwrap();
     assert_error(merge(&[&damaged], None), &["damaged.exr", "pixel (5, 0)"]);
     let mut small = record(0..8, 1);
     small.identity.width = SIZE / 2;

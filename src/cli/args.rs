@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 use super::environment::{EnvironmentChoice, parse_degrees, parse_environment, parse_strength};
 use crate::limits::parse_size;
 use crate::load::GltfLightUnits;
+use crate::output::ViewTransform;
 use crate::record::parse_range;
 use crate::render::FilterKind;
 
@@ -180,6 +181,16 @@ pub struct Args {
     #[arg(long, value_name = "PIXELS", value_parser = parse_filter_width)]
     pub filter_width: Option<f32>,
 
+    /// Scale every output by 2^EV (EXR and PNG alike; recorded, so parts merge only at
+    /// equal exposure).
+    #[arg(long, value_name = "EV", default_value_t = 0.0, value_parser = parse_exposure, allow_hyphen_values = true)]
+    pub exposure: f32,
+
+    /// How a PNG shows the linear image: `standard` (the sRGB curve, clipping at 1) or
+    /// `agx` (Blender's default view transform, which rolls highlights off). EXR stays linear.
+    #[arg(long, value_enum, value_name = "VIEW", default_value = "standard")]
+    pub view_transform: ViewTransform,
+
     /// Every SECONDS, write the image so far to the output (atomically, as a part that
     /// `gridtrace merge` accepts), so a killed render keeps its samples.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
@@ -217,6 +228,10 @@ pub struct MergeArgs {
     /// Most memory to use; see `gridtrace --help`.
     #[arg(long, value_name = "SIZE", value_parser = parse_size)]
     pub max_memory: Option<u64>,
+
+    /// How a PNG output shows the linear image; see `gridtrace --help`.
+    #[arg(long, value_enum, value_name = "VIEW", default_value = "standard")]
+    pub view_transform: ViewTransform,
 }
 
 /// `text` as a number that `accepts`, or an error saying it is not `what`.
@@ -261,6 +276,15 @@ fn parse_filter_width(text: &str) -> Result<f32, String> {
         text,
         |w| range.contains(&w),
         "a filter width from 1/64 to 16 pixels",
+    )
+}
+
+/// An exposure adjustment in stops, within ±64.
+fn parse_exposure(text: &str) -> Result<f32, String> {
+    parse_number(
+        text,
+        |ev: f32| (-64.0..=64.0).contains(&ev),
+        "an exposure from -64 to +64 stops",
     )
 }
 

@@ -229,10 +229,13 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
                 .map_or_else(String::new, |v| v.get_name().to_string()),
             settings.filter_width
         ),
+        exposure: args.exposure,
     };
     let scene_name = scene_path
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    // Exposure scales what is written, never what is accumulated.
+    let exposed = |image: Image| image.scaled(args.exposure.exp2());
     let record_of = |image: &Image, stats: &RenderStats| RenderRecord {
         identity: identity.clone(),
         scene_name: scene_name.clone(),
@@ -250,8 +253,14 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
             return;
         }
         let (image, stats) = image_so_far();
+        let image = exposed(image);
         let _writing = output_lock();
-        if let Err(e) = write_image_with_record(&output, &image, Some(&record_of(&image, &stats))) {
+        if let Err(e) = write_image_with_record(
+            &output,
+            &image,
+            Some(&record_of(&image, &stats)),
+            args.view_transform,
+        ) {
             checkpoint_error = Some(e);
         }
         last_checkpoint = Instant::now();
@@ -279,9 +288,15 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
             stats.nonfinite
         );
     }
+    let image = exposed(image);
     {
         let _writing = output_lock();
-        write_image_with_record(&output, &image, Some(&record_of(&image, &stats)))?;
+        write_image_with_record(
+            &output,
+            &image,
+            Some(&record_of(&image, &stats)),
+            args.view_transform,
+        )?;
         set_phase(Phase::Finished);
     }
     if !args.quiet {
@@ -322,7 +337,7 @@ fn run_merge(args: &MergeArgs) -> Result<()> {
     }
     {
         let _writing = output_lock();
-        write_image_with_record(&args.output, &image, Some(&record))?;
+        write_image_with_record(&args.output, &image, Some(&record), args.view_transform)?;
         set_phase(Phase::Finished);
     }
     if !args.quiet {

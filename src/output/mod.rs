@@ -1,9 +1,12 @@
-//! Writing images: OpenEXR (linear float) and PNG (sRGB 8-bit), always atomically.
+//! Writing images: OpenEXR (linear float) and PNG (8-bit sRGB through a view transform),
+//! always atomically.
 
+mod agx;
 mod exr;
 mod png;
 
 pub use exr::{ExrHeader, read_header as read_exr_header, read_rgba as read_exr_rgba};
+pub use png::{ViewTransform, display_bytes};
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -16,7 +19,7 @@ use crate::render::Image;
 pub enum Format {
     /// OpenEXR, 32-bit float linear RGBA.
     Exr,
-    /// PNG, 8-bit sRGB RGB.
+    /// PNG, 8-bit sRGB RGB through a [`ViewTransform`].
     Png,
 }
 
@@ -61,19 +64,28 @@ impl Format {
 /// go to a temporary file in the same folder, which is renamed over `path` only when
 /// complete, so an earlier image at `path` survives any failure.
 pub fn write_image(path: &Path, image: &Image) -> Result<(), OutputError> {
-    write_image_with_record(path, image, None)
+    write_image_with_record(path, image, None, ViewTransform::Standard)
 }
 
-/// [`write_image`], with the render's record in an EXR's header (PNG has no place for it).
+/// [`write_image`], with the render's record in an EXR's header or a PNG's text chunk (the
+/// PNG's record also names its view transform, which an EXR does not apply).
 pub fn write_image_with_record(
     path: &Path,
     image: &Image,
     record: Option<&RenderRecord>,
+    view: ViewTransform,
 ) -> Result<(), OutputError> {
     let record = record.map(RenderRecord::to_text);
     let bytes = match Format::from_path(path)? {
         Format::Exr => exr::encode(image, record.as_deref().map(|r| (RECORD_ATTRIBUTE, r))),
-        Format::Png => png::encode(image),
+        Format::Png => {
+            let record = record.map(|r| format!("{r}viewTransform={}\n", view.name()));
+            png::encode(
+                image,
+                view,
+                record.as_deref().map(|r| (RECORD_ATTRIBUTE, r)),
+            )
+        }
     }
     .map_err(|message| OutputError::Write {
         path: path.to_path_buf(),

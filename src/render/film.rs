@@ -46,6 +46,14 @@ impl Image {
         self.pixels[(y * self.width + x) as usize]
     }
 
+    /// The image with every radiance multiplied by `factor` (alpha unchanged).
+    pub fn scaled(mut self, factor: f32) -> Image {
+        if factor != 1.0 {
+            self.pixels.iter_mut().for_each(|p| *p *= factor);
+        }
+        self
+    }
+
     /// Mean of all pixels.
     pub fn mean(&self) -> Vec3 {
         let sum = self
