@@ -37,6 +37,8 @@ fn spot(z: f32, side: f32, radius: f32, focus: f32) -> (f64, f64) {
             focus_distance: focus,
         }),
         focal_length: None,
+        shutter: None,
+        motion: None,
         source: "test".into(),
     };
     let settings = RenderSettings {

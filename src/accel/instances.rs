@@ -3,13 +3,15 @@
 //! Rays are carried into each instance's object space, so a mesh used by many nodes is
 //! stored once and never needs rebuilding (the "teapot in a stadium" stays cheap). Scenes
 //! exported from Blender hold tens of objects, so the instances are tested in a flat list
-//! after a bounding-box check.
+//! after a bounding-box check. A moving instance is placed at each ray's time, inside
+//! bounds that hold it over the whole shutter; a time slice of a deforming mesh is seen
+//! only by rays whose time falls in it.
 
 use glam::{Affine3A, Vec3};
 use rayon::prelude::*;
 
 use super::{Grid, Ray};
-use crate::scene::{Aabb, Scene};
+use crate::scene::{Aabb, Motion, Scene, TimeSlice};
 
 /// A closest hit in the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,12 +26,33 @@ pub struct SceneHit {
     pub u: f32,
     /// Barycentric weight of the triangle's third vertex.
     pub v: f32,
+    /// Shutter time of the ray that found it.
+    pub time: f32,
 }
 
 struct PlacedInstance {
     grid: usize,
     object_from_world: Affine3A,
     world_bounds: Aabb,
+    /// World-from-object over the shutter, when it moves.
+    motion: Option<Motion>,
+    slice: Option<TimeSlice>,
+}
+
+impl PlacedInstance {
+    /// The ray in object space, or `None` when the instance is not there at its time or
+    /// the ray misses its bounds.
+    fn local_ray(&self, ray: &Ray, t_max: f32) -> Option<Ray> {
+        if self.slice.as_ref().is_some_and(|s| !s.contains(ray.time))
+            || !hits_box(&self.world_bounds, ray, t_max)
+        {
+            return None;
+        }
+        Some(match &self.motion {
+            None => to_object(ray, &self.object_from_world),
+            Some(motion) => to_object(ray, &motion.at(ray.time).inverse()),
+        })
+    }
 }
 
 /// Ray queries over a whole scene.
@@ -49,13 +72,20 @@ impl SceneAccel {
         let instances = scene
             .instances
             .iter()
-            .map(|inst| PlacedInstance {
-                grid: inst.mesh,
-                object_from_world: inst.world_from_object.inverse(),
-                world_bounds: culling_bounds(
-                    &scene.meshes[inst.mesh].bounds(),
-                    &inst.world_from_object,
-                ),
+            .map(|inst| {
+                let object = scene.meshes[inst.mesh].bounds();
+                PlacedInstance {
+                    grid: inst.mesh,
+                    object_from_world: inst.world_from_object.inverse(),
+                    world_bounds: match &inst.motion {
+                        None => culling_bounds(&object, &inst.world_from_object),
+                        Some(motion) => motion.keys().iter().fold(Aabb::EMPTY, |b, key| {
+                            b.union(culling_bounds(&object, key))
+                        }),
+                    },
+                    motion: inst.motion.clone(),
+                    slice: inst.slice,
+                }
             })
             .collect();
         SceneAccel { grids, instances }
@@ -71,11 +101,10 @@ impl SceneAccel {
         let mut best: Option<SceneHit> = None;
         let mut t_max = ray.t_max;
         for (i, inst) in self.instances.iter().enumerate() {
-            if !hits_box(&inst.world_bounds, ray, t_max) {
+            let Some(local) = inst.local_ray(ray, t_max) else {
                 continue;
-            }
-            let local = to_object(ray, &inst.object_from_world).with_t_max(t_max);
-            if let Some(hit) = self.grids[inst.grid].intersect(&local) {
+            };
+            if let Some(hit) = self.grids[inst.grid].intersect(&local.with_t_max(t_max)) {
                 t_max = hit.t;
                 best = Some(SceneHit {
                     t: hit.t,
@@ -83,6 +112,7 @@ impl SceneAccel {
                     triangle: hit.triangle,
                     u: hit.u,
                     v: hit.v,
+                    time: ray.time,
                 });
             }
         }
@@ -92,8 +122,8 @@ impl SceneAccel {
     /// True when anything blocks `ray` within (`t_min`, `t_max`).
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.instances.iter().any(|inst| {
-            hits_box(&inst.world_bounds, ray, ray.t_max)
-                && self.grids[inst.grid].occluded(&to_object(ray, &inst.object_from_world))
+            inst.local_ray(ray, ray.t_max)
+                .is_some_and(|local| self.grids[inst.grid].occluded(&local))
         })
     }
 }

@@ -15,6 +15,8 @@ pub struct Ray {
     pub t_min: f32,
     /// Hits at or after this parameter are ignored.
     pub t_max: f32,
+    /// Shutter time in [0, 1] at which the ray sees the scene (0 for still scenes).
+    pub time: f32,
 }
 
 impl Ray {
@@ -25,7 +27,13 @@ impl Ray {
             direction,
             t_min: 0.0,
             t_max: f32::INFINITY,
+            time: 0.0,
         }
+    }
+
+    /// The same ray at shutter time `time`.
+    pub fn at_time(self, time: f32) -> Ray {
+        Ray { time, ..self }
     }
 
     /// The same ray limited to `t < t_max`.

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand};
 
 use super::environment::{EnvironmentChoice, parse_degrees, parse_environment, parse_strength};
+use super::motion::{parse_motion_steps, parse_shutter};
 use crate::limits::parse_size;
 use crate::load::GltfLightUnits;
 use crate::output::ViewTransform;
@@ -180,6 +181,17 @@ pub struct Args {
     /// Width of the pixel filter in pixels. [default: 1 for box, 1.5 for the others]
     #[arg(long, value_name = "PIXELS", value_parser = parse_filter_width)]
     pub filter_width: Option<f32>,
+
+    /// Motion blur: the shutter's interval in frames relative to the frame rendered
+    /// (`-0.25..0.25` is Blender's default half-frame shutter centred on the frame; `0..0`
+    /// turns blur off). [default: the USD camera's shutter:open..shutter:close, else none]
+    #[arg(long, value_name = "OPEN..CLOSE", value_parser = parse_shutter, allow_hyphen_values = true)]
+    pub shutter: Option<[f64; 2]>,
+
+    /// Instants across the shutter at which the scene is read (2 to 64): moving objects
+    /// follow straight lines between them; deforming meshes are kept at each.
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = parse_motion_steps)]
+    pub motion_steps: usize,
 
     /// Scale every output by 2^EV (EXR and PNG alike; recorded, so parts merge only at
     /// equal exposure).

@@ -4,6 +4,7 @@
 
 mod args;
 mod environment;
+mod motion;
 pub mod signals;
 
 pub use args::{Args, Command, MergeArgs};
@@ -121,6 +122,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let scene_sha256 =
         sha256_file(scene_path).with_context(|| format!("{}", scene_path.display()))?;
     let loaded = load_scene_with(scene_path, &options)?;
+    let (loaded, shutter_label) = motion::apply_shutter(loaded, args, scene_path, &options)?;
     let scene_dir = folder_of(scene_path);
     let dependencies_sha256 =
         sha256_files(scene_dir, &loaded.files).context("hashing the files the scene reads")?;
@@ -222,7 +224,7 @@ pub fn run(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         seed: settings.seed,
         max_depth: settings.max_depth,
         load_options: format!(
-            "{} {environment_label} filter={}:{}",
+            "{}{shutter_label} {environment_label} filter={}:{}",
             load_options_label(&options),
             args.filter
                 .to_possible_value()

@@ -5,6 +5,7 @@ mod error;
 pub mod gltf;
 pub mod guard;
 mod images;
+pub mod motion;
 pub mod ply;
 mod polygon;
 mod subdivision;
@@ -30,6 +31,9 @@ pub struct Loaded {
     /// Other files the scene was read from (glTF buffers and images, USD layers and
     /// textures), so a render's record can say exactly what it rendered.
     pub files: Vec<Dependency>,
+    /// The frame it was read at, when the file has a timeline and one was used (USD: the
+    /// time code; glTF: `--frame`): motion blur reads it again around this frame.
+    pub frame: Option<f64>,
 }
 
 /// How to read what a file leaves to convention.

@@ -259,6 +259,7 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
         scene: builder.build(),
         warnings: Vec::new(),
         files: Vec::new(),
+        frame: None,
     })
 }
 

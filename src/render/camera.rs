@@ -4,12 +4,14 @@ use glam::{Affine3A, Vec2, Vec3};
 
 use super::sampling::concentric_disk;
 use crate::accel::Ray;
-use crate::scene::{Camera, Projection, ThinLens};
+use crate::scene::{Camera, Motion, Projection, ThinLens};
 
 /// Generates the ray through a point of the image plane.
 #[derive(Clone, Debug)]
 pub struct RayGenerator {
     world_from_camera: Affine3A,
+    /// `world_from_camera` over the shutter, when the camera moves.
+    motion: Option<Motion>,
     projection: Projection,
     /// Half-extent of the image plane at distance 1 (perspective) or in scene units
     /// (orthographic), horizontally and vertically.
@@ -34,6 +36,7 @@ impl RayGenerator {
         };
         RayGenerator {
             world_from_camera: camera.world_from_camera,
+            motion: camera.motion.clone(),
             projection: camera.projection,
             half_extent,
             znear: camera.znear.max(0.0),
@@ -51,7 +54,7 @@ impl RayGenerator {
     /// The direction is not normalised: its camera-space z is −1, so `t_min = znear` clips
     /// exactly at the near plane.
     pub fn generate(&self, x: f32, y: f32) -> Ray {
-        self.generate_through_lens(x, y, Vec2::splat(0.5))
+        self.generate_through_lens(x, y, Vec2::splat(0.5), 0.0)
     }
 
     /// True when rays leave a lens of some size: each sample then needs a lens position.
@@ -61,8 +64,8 @@ impl RayGenerator {
 
     /// [`RayGenerator::generate`] from the point of the lens that uniforms `u` pick (the
     /// concentric map onto the aperture disc); the centre, (½, ½), is the pinhole's ray.
-    /// The direction keeps camera-space z = −1.
-    pub fn generate_through_lens(&self, x: f32, y: f32, u: Vec2) -> Ray {
+    /// The direction keeps camera-space z = −1. `time` is the sample's shutter time.
+    pub fn generate_through_lens(&self, x: f32, y: f32, u: Vec2, time: f32) -> Ray {
         let ndc = Vec2::new(
             2.0 * x / self.width as f32 - 1.0,
             1.0 - 2.0 * y / self.height as f32,
@@ -81,11 +84,20 @@ impl RayGenerator {
             }
             (Projection::Orthographic { .. }, _) => (Vec3::new(plane.x, plane.y, 0.0), Vec3::NEG_Z),
         };
+        let moved;
+        let world_from_camera = match &self.motion {
+            None => &self.world_from_camera,
+            Some(motion) => {
+                moved = motion.at(time);
+                &moved
+            }
+        };
         Ray {
-            origin: self.world_from_camera.transform_point3(origin),
-            direction: self.world_from_camera.transform_vector3(direction),
+            origin: world_from_camera.transform_point3(origin),
+            direction: world_from_camera.transform_vector3(direction),
             t_min: self.znear,
             t_max: f32::INFINITY,
+            time,
         }
     }
 }
@@ -106,6 +118,8 @@ mod tests {
             znear: 0.1,
             lens: None,
             focal_length: None,
+            shutter: None,
+            motion: None,
             source: String::new(),
         };
         let g = RayGenerator::new(&cam, 200, 100);

@@ -130,7 +130,8 @@ impl Renderer<'_> {
                 ray = Ray::new(
                     offset_ray_origin(s.point, s.point_error, ng, ray.direction),
                     ray.direction,
-                );
+                )
+                .at_time(s.time);
                 continue;
             }
             result.hit |= depth == 0;
@@ -149,7 +150,7 @@ impl Renderer<'_> {
             if material.is_emissive() && (front || material.double_sided) {
                 let light_pdf = self
                     .lights
-                    .pdf(hit.instance, hit.triangle, travelled, cos_o);
+                    .pdf(hit.instance, hit.triangle, hit.time, travelled, cos_o);
                 let weight = emission_weight(arrival, strategy, light_pdf);
                 result.radiance += weight * beta * shading.emission;
             }
@@ -205,7 +206,8 @@ impl Renderer<'_> {
             ray = Ray::new(
                 offset_ray_origin(s.point, s.point_error, ng, sample.wi),
                 sample.wi,
-            );
+            )
+            .at_time(s.time);
             vertex = s.point;
             travelled = 0.0;
             depth += 1;
@@ -250,7 +252,7 @@ impl Renderer<'_> {
         let sample = if strategy == Strategy::BsdfOnly {
             self.lights.sample_punctual(s.point, u_light)
         } else {
-            self.lights.sample(self.scene, s.point, u_light, u)
+            self.lights.sample(self.scene, s.point, s.time, u_light, u)
         };
         let Some(ls) = sample else {
             return Vec3::ZERO;
@@ -273,6 +275,7 @@ impl Renderer<'_> {
             direction: target - origin,
             t_min: 0.0,
             t_max: 1.0 - SHADOW_EPSILON,
+            time: s.time,
         };
         if self.occluded(&shadow, rng) {
             return Vec3::ZERO;

@@ -174,6 +174,7 @@ impl<'a> Renderer<'a> {
     ) -> (Image, RenderStats) {
         let start = Instant::now();
         let generator = RayGenerator::new(camera, settings.width, settings.height);
+        let timed = camera.motion.is_some() || self.scene.has_moving_geometry();
         let filter = PixelFilter::new(settings.filter, settings.filter_width);
         let width = settings.width as usize;
         let spp = settings.spp.max(1).min(u32::MAX - settings.first_sample);
@@ -198,8 +199,10 @@ impl<'a> Renderer<'a> {
                         } else {
                             glam::Vec2::splat(0.5)
                         };
+                        // A shutter time only when something moves, likewise.
+                        let time = if timed { rng.uniform() } else { 0.0 };
                         let (px, py) = (x as f32 + at.x, y as f32 + at.y);
-                        let ray = generator.generate_through_lens(px, py, lens);
+                        let ray = generator.generate_through_lens(px, py, lens, time);
                         let path =
                             self.trace_path(ray, &mut rng, settings.max_depth, settings.strategy);
                         rays += path.rays;

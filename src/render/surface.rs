@@ -25,6 +25,8 @@ pub struct Surface {
     pub vertices: [usize; 3],
     /// Barycentric weights of `vertices` at the hit.
     pub barycentrics: Vec3,
+    /// Shutter time of the path that found it: the rays it spawns see the scene then too.
+    pub time: f32,
 }
 
 /// γ(n) = nε / (1 − nε), the bound on the relative error of n chained floating-point
@@ -87,17 +89,21 @@ pub struct InstanceFrame {
 }
 
 impl InstanceFrame {
-    /// Precomputes the normal matrix of every instance.
+    /// The frame of an instance placed by `world_from_object`.
+    pub fn new(world_from_object: Affine3A) -> InstanceFrame {
+        InstanceFrame {
+            world_from_object,
+            normal_matrix: Mat3::from(world_from_object.matrix3).inverse().transpose(),
+        }
+    }
+
+    /// Precomputes the frame of every instance (at the frame's instant for moving ones,
+    /// which [`surface_at`] places at each hit's time instead).
     pub fn for_scene(scene: &Scene) -> Vec<InstanceFrame> {
         scene
             .instances
             .iter()
-            .map(|inst| InstanceFrame {
-                world_from_object: inst.world_from_object,
-                normal_matrix: Mat3::from(inst.world_from_object.matrix3)
-                    .inverse()
-                    .transpose(),
-            })
+            .map(|inst| InstanceFrame::new(inst.world_from_object))
             .collect()
     }
 }
@@ -105,7 +111,14 @@ impl InstanceFrame {
 /// The surface at `hit`.
 pub fn surface_at(scene: &Scene, frames: &[InstanceFrame], hit: &SceneHit) -> Surface {
     let inst = &scene.instances[hit.instance as usize];
-    let frame = &frames[hit.instance as usize];
+    let moved;
+    let frame = match &inst.motion {
+        None => &frames[hit.instance as usize],
+        Some(motion) => {
+            moved = InstanceFrame::new(motion.at(hit.time));
+            &moved
+        }
+    };
     let mesh = &scene.meshes[inst.mesh];
     let [a, b, c] = mesh.indices[hit.triangle as usize].map(|i| i as usize);
     let p = [a, b, c].map(|i| mesh.positions[i]);
@@ -132,5 +145,6 @@ pub fn surface_at(scene: &Scene, frames: &[InstanceFrame], hit: &SceneHit) -> Su
         instance: hit.instance as usize,
         vertices: [a, b, c],
         barycentrics: Vec3::new(w, hit.u, hit.v),
+        time: hit.time,
     }
 }

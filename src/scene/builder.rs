@@ -77,6 +77,8 @@ impl SceneBuilder {
             mesh,
             world_from_object,
             source: source.into(),
+            motion: None,
+            slice: None,
         });
     }
 

@@ -2,6 +2,8 @@
 
 use glam::Affine3A;
 
+use super::Motion;
+
 /// The projection of a camera that looks down its local −Z axis with +Y up (glTF convention).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
@@ -47,6 +49,11 @@ pub struct Camera {
     pub lens: Option<ThinLens>,
     /// Focal length in scene units where the file says it (USD), for `--fstop`.
     pub focal_length: Option<f32>,
+    /// When the shutter opens and closes, in frames relative to the frame rendered, where
+    /// the file says it (USD `shutter:open`, `shutter:close`).
+    pub shutter: Option<[f64; 2]>,
+    /// `world_from_camera` over the shutter, when the camera moves.
+    pub motion: Option<Motion>,
     /// Where the camera came from, for messages.
     pub source: String,
 }
@@ -145,6 +152,8 @@ impl Camera {
             znear: 1e-3 * distance,
             lens: None,
             focal_length: None,
+            shutter: None,
+            motion: None,
             source: "default camera framing the scene".into(),
         }
     }

@@ -10,6 +10,7 @@ mod environment;
 mod light;
 mod material;
 mod mesh;
+mod motion;
 mod texture;
 
 pub use builder::SceneBuilder;
@@ -18,6 +19,7 @@ pub use environment::{Environment, EnvironmentMap, blender_world_rotation, map_d
 pub use light::{Light, LightKind};
 pub use material::{AlphaMode, ChannelRef, Material, MaterialTextures, Pbr, f0_of_ior};
 pub use mesh::Mesh;
+pub use motion::{Motion, TimeSlice};
 pub use texture::{ColorSpace, Filter, Texture, TextureRef, Wrap, linear_to_srgb, srgb_to_linear};
 
 use glam::{Affine3A, Vec3};
@@ -31,6 +33,11 @@ pub struct Instance {
     pub world_from_object: Affine3A,
     /// Where this instance came from, for messages.
     pub source: String,
+    /// Its transform over the shutter, when it moves (`world_from_object` is then the
+    /// transform at the frame itself, for everything that does not trace rays).
+    pub motion: Option<Motion>,
+    /// For one time slice of a deforming mesh: the part of the shutter it is seen in.
+    pub slice: Option<TimeSlice>,
 }
 
 /// An axis-aligned bounding box.
@@ -126,14 +133,14 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// World-space bounds of every instance.
+    /// World-space bounds of every instance (over the whole shutter for moving ones).
     pub fn bounds(&self) -> Aabb {
         self.instances.iter().fold(Aabb::EMPTY, |b, inst| {
-            b.union(
-                self.meshes[inst.mesh]
-                    .bounds()
-                    .transformed(&inst.world_from_object),
-            )
+            let object = self.meshes[inst.mesh].bounds();
+            b.union(match &inst.motion {
+                None => object.transformed(&inst.world_from_object),
+                Some(motion) => motion.bounds(&object),
+            })
         })
     }
 
@@ -145,6 +152,13 @@ impl Scene {
                 let mesh = &self.meshes[inst.mesh];
                 self.materials[mesh.material].is_emissive() && !mesh.indices.is_empty()
             })
+    }
+
+    /// True when some geometry moves or deforms during the shutter.
+    pub fn has_moving_geometry(&self) -> bool {
+        self.instances
+            .iter()
+            .any(|i| i.motion.is_some() || i.slice.is_some())
     }
 
     /// Number of triangles after instancing.

@@ -125,6 +125,8 @@ pub fn camera_at(z: f32, yfov_degrees: f32) -> Camera {
         znear: 0.0,
         lens: None,
         focal_length: None,
+        shutter: None,
+        motion: None,
         source: "test".into(),
     }
 }

@@ -138,6 +138,7 @@ pub fn load_bytes_with(
         scene: loader.builder.build(),
         warnings: loader.warnings,
         files,
+        frame: options.frame,
     })
 }
 
@@ -397,6 +398,8 @@ impl GltfLoader {
             znear,
             lens: None,
             focal_length: None,
+            shutter: None,
+            motion: None,
             source: source.to_string(),
         });
     }

@@ -1,9 +1,11 @@
-//! UsdGeom cameras: projection, clipping and a thin lens from `fStop` and `focusDistance`.
+//! UsdGeom cameras: projection, clipping, a thin lens from `fStop` and `focusDistance`, and
+//! the shutter interval.
 
 use glam::{Affine3A, Mat4};
 use openusd::sdf;
 
 use super::UsdLoader;
+use super::value::as_f64;
 use crate::scene::{Camera, Projection, ThinLens};
 
 impl UsdLoader {
@@ -50,6 +52,10 @@ impl UsdLoader {
                     focus_distance: focus,
                 }
             });
+        // Frame-relative shutter interval (UsdGeomCamera; both 0 by default: no blur).
+        let open = self.get(prim, "shutter:open").as_ref().and_then(as_f64).unwrap_or(0.0);
+        let close = self.get(prim, "shutter:close").as_ref().and_then(as_f64).unwrap_or(0.0);
+        let shutter = (open.is_finite() && close.is_finite() && close > open).then_some([open, close]);
         self.builder.add_camera(Camera {
             name: where_.clone(),
             world_from_camera: Affine3A::from_rotation_translation(
@@ -60,6 +66,8 @@ impl UsdLoader {
             znear: znear * scale.y,
             lens,
             focal_length: (focal_length > 0.0).then_some(focal_length),
+            shutter,
+            motion: None,
             source: where_,
         });
     }

@@ -176,6 +176,7 @@ fn read_stage(
         scene: loader.builder.build(),
         warnings: loader.warnings,
         files,
+        frame: Some(loader.time.value()),
     })
 }
 

@@ -8,29 +8,60 @@ mod sphere;
 
 use std::collections::HashMap;
 
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 
 pub use environment::EnvironmentLight;
 
 use super::sampling::{Distribution1d, uniform_triangle};
 use super::shading::vertex_uv;
 use super::surface::{interpolate_with_error, transform_point_with_error};
-use crate::scene::{ColorSpace, LightKind, Scene, TextureRef};
+use crate::scene::{ColorSpace, LightKind, Motion, Scene, TextureRef, TimeSlice};
 
 /// One emitting triangle in world space.
 #[derive(Clone, Copy, Debug)]
 struct EmissiveTriangle {
-    /// World-space corners with the rounding-error bound the transform added to each.
-    corners: [(Vec3, Vec3); 3],
-    /// Unit geometric normal, on the side the winding calls front.
-    normal: Vec3,
-    area: f32,
+    /// Where it is (at the frame's instant, for a moving one).
+    placed: PlacedTriangle,
+    /// For a moving instance's triangle: its object-space corners and the index of the
+    /// instance's motion in [`LightSet::motions`], to place it at each path's time.
+    moving: Option<([Vec3; 3], u32)>,
+    /// For a time slice of a deforming mesh: when it is there.
+    slice: Option<TimeSlice>,
     radiance: Vec3,
     /// The material's emitted power per unit area (W/m²).
     exitance: f32,
     double_sided: bool,
     /// The emissive texture and the triangle's coordinates in it, if the emission varies.
     texture: Option<(TextureRef, [Vec2; 3])>,
+}
+
+/// A triangle placed in world space.
+#[derive(Clone, Copy, Debug)]
+struct PlacedTriangle {
+    /// World-space corners with the rounding-error bound the transform added to each.
+    corners: [(Vec3, Vec3); 3],
+    /// Unit geometric normal, on the side the winding calls front.
+    normal: Vec3,
+    area: f32,
+}
+
+impl PlacedTriangle {
+    /// The object-space triangle `object` placed by `m`. Mirroring transforms flip the
+    /// winding; the normal follows the object-space front face, which is what the
+    /// renderer's hit normal uses too.
+    fn new(m: &Affine3A, object: [Vec3; 3]) -> PlacedTriangle {
+        let corners = object.map(|p| transform_point_with_error(m, p));
+        let [p0, p1, p2] = corners.map(|c| c.0);
+        let cross = (p1 - p0).cross(p2 - p0);
+        let area = 0.5 * cross.length();
+        let usable = area.is_finite() && area > 0.0;
+        let sign = if m.matrix3.determinant() < 0.0 { -1.0 } else { 1.0 };
+        PlacedTriangle {
+            corners,
+            normal: if usable { sign * cross / (2.0 * area) } else { Vec3::Z },
+            area: if usable { area } else { 0.0 },
+        }
+    }
 }
 
 /// A point drawn on a light, as seen from a shading point.
@@ -90,6 +121,8 @@ pub struct LightSet {
     scene_center: Vec3,
     /// For each instance, the index of its mesh's first triangle in `triangles`, if emissive.
     first_of_instance: Vec<Option<u32>>,
+    /// The motions of moving emissive instances.
+    motions: Vec<Motion>,
 }
 
 impl LightSet {
@@ -98,6 +131,7 @@ impl LightSet {
     pub fn build(scene: &Scene) -> LightSet {
         let mut triangles = Vec::new();
         let mut first_of_instance = Vec::with_capacity(scene.instances.len());
+        let mut motions = Vec::new();
         for inst in &scene.instances {
             let mesh = &scene.meshes[inst.mesh];
             let material = &scene.materials[mesh.material];
@@ -108,29 +142,16 @@ impl LightSet {
             first_of_instance.push(Some(triangles.len() as u32));
             let m = inst.world_from_object;
             let texture = material.textures.emissive;
+            let motion = inst.motion.clone().map(|motion| {
+                motions.push(motion);
+                motions.len() as u32 - 1
+            });
             for &[a, b, c] in &mesh.indices {
-                let corners =
-                    [a, b, c].map(|i| transform_point_with_error(&m, mesh.positions[i as usize]));
-                let [p0, p1, p2] = corners.map(|c| c.0);
-                let (e1, e2) = (p1 - p0, p2 - p0);
-                let cross = e1.cross(e2);
-                let area = 0.5 * cross.length();
-                let usable = area.is_finite() && area > 0.0;
-                // Mirroring transforms flip the winding; the normal follows the object-space
-                // front face, which is what the renderer's hit normal uses too.
-                let sign = if m.matrix3.determinant() < 0.0 {
-                    -1.0
-                } else {
-                    1.0
-                };
+                let object = [a, b, c].map(|i| mesh.positions[i as usize]);
                 triangles.push(EmissiveTriangle {
-                    corners,
-                    normal: if usable {
-                        sign * cross / (2.0 * area)
-                    } else {
-                        Vec3::Z
-                    },
-                    area: if usable { area } else { 0.0 },
+                    placed: PlacedTriangle::new(&m, object),
+                    moving: motion.map(|k| (object, k)),
+                    slice: inst.slice,
                     radiance: material.emission,
                     exitance: material.exitance(),
                     double_sided: material.double_sided,
@@ -173,6 +194,7 @@ impl LightSet {
             scene_radius,
             scene_center,
             first_of_instance,
+            motions,
         };
         // A textured emitter counts with its texture's mean.
         let mut texture_means = HashMap::new();
@@ -210,7 +232,7 @@ impl LightSet {
             Light::Triangle(i) => {
                 let t = &self.triangles[i];
                 let scale = t.texture.map_or(1.0, |(r, _)| texture_mean(r));
-                t.area * t.exitance * scale
+                t.placed.area * t.exitance * scale
             }
             Light::Punctual(i) => self.punctual[i].power(self.scene_radius),
             Light::Environment => self
@@ -247,10 +269,18 @@ impl LightSet {
 
     /// Draws a point on a light for shading point `p`: a light by power, then a point on it
     /// by that light's own rule.
-    pub fn sample(&self, scene: &Scene, p: Vec3, u_light: f32, u: Vec2) -> Option<LightSample> {
+    /// `time` is the path's shutter time, for lights that move.
+    pub fn sample(
+        &self,
+        scene: &Scene,
+        p: Vec3,
+        time: f32,
+        u_light: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
         let (index, pmf) = self.distribution.sample(u_light)?;
         match self.lights[index] {
-            Light::Triangle(i) => self.sample_triangle(scene, i, pmf, p, u),
+            Light::Triangle(i) => self.sample_triangle(scene, i, pmf, p, time, u),
             Light::Punctual(i) => self.sample_punctual_light(i, pmf, p, u),
             Light::Environment => self.sample_environment(pmf, p, u),
         }
@@ -264,11 +294,17 @@ impl LightSet {
         index: usize,
         pmf: f32,
         p: Vec3,
+        time: f32,
         u: Vec2,
     ) -> Option<LightSample> {
         let tri = &self.triangles[index];
+        let placed = self.placed_at(tri, time)?;
+        if placed.area == 0.0 {
+            return None;
+        }
         let b = uniform_triangle(u);
-        let (point, point_error) = interpolate_with_error(tri.corners, [1.0 - b.x - b.y, b.x, b.y]);
+        let (point, point_error) =
+            interpolate_with_error(placed.corners, [1.0 - b.x - b.y, b.x, b.y]);
         let to_light = point - p;
         let distance_sq = to_light.length_squared();
         let distance = distance_sq.sqrt();
@@ -276,11 +312,11 @@ impl LightSet {
             return None;
         }
         let wi = to_light / distance;
-        let cos_light = tri.normal.dot(-wi);
+        let cos_light = placed.normal.dot(-wi);
         if cos_light == 0.0 {
             return None;
         }
-        let pdf = pmf / tri.area * distance_sq / cos_light.abs();
+        let pdf = pmf / placed.area * distance_sq / cos_light.abs();
         let mut radiance = if tri.double_sided || cos_light > 0.0 {
             tri.radiance
         } else {
@@ -295,7 +331,7 @@ impl LightSet {
         Some(LightSample {
             point,
             point_error,
-            normal: tri.normal,
+            normal: placed.normal,
             wi,
             distance,
             radiance,
@@ -450,15 +486,39 @@ impl LightSet {
 
     /// The solid-angle density with which [`LightSet::sample`] would pick the point of
     /// triangle `triangle` of instance `instance` at `distance` and light cosine `cos_light`.
-    pub fn pdf(&self, instance: u32, triangle: u32, distance: f32, cos_light: f32) -> f32 {
+    /// `time` is the shutter time of the ray that hit it.
+    pub fn pdf(
+        &self,
+        instance: u32,
+        triangle: u32,
+        time: f32,
+        distance: f32,
+        cos_light: f32,
+    ) -> f32 {
         let Some(first) = self.first_of_instance[instance as usize] else {
             return 0.0;
         };
         let index = (first + triangle) as usize;
-        let tri = &self.triangles[index];
-        if tri.area == 0.0 || cos_light == 0.0 {
+        let Some(placed) = self.placed_at(&self.triangles[index], time) else {
+            return 0.0;
+        };
+        if placed.area == 0.0 || cos_light == 0.0 {
             return 0.0;
         }
-        self.distribution.pmf(index) / tri.area * distance * distance / cos_light.abs()
+        self.distribution.pmf(index) / placed.area * distance * distance / cos_light.abs()
+    }
+
+    /// Where `tri` is at shutter time `time`, or `None` when it is not there then (a time
+    /// slice of a deforming mesh). A slice's triangles keep their share of the light
+    /// distribution at every time; samples drawn from them outside it bring nothing, which
+    /// wastes them but keeps the estimate unbiased.
+    fn placed_at(&self, tri: &EmissiveTriangle, time: f32) -> Option<PlacedTriangle> {
+        if tri.slice.is_some_and(|s| !s.contains(time)) {
+            return None;
+        }
+        Some(match tri.moving {
+            None => tri.placed,
+            Some((object, k)) => PlacedTriangle::new(&self.motions[k as usize].at(time), object),
+        })
     }
 }
