@@ -6,7 +6,7 @@ mod shapes;
 use glam::{Affine3A, Vec3};
 use gridtrace::load::load_scene;
 use gridtrace::render::{Image, RenderSettings, Renderer, Strategy};
-use gridtrace::scene::{Camera, Material, Pbr, Scene, SceneBuilder};
+use gridtrace::scene::{Camera, Instance, Material, Motion, Pbr, Scene, SceneBuilder, TimeSlice};
 use shapes::{add_box_inside, add_quad, add_sphere, camera_at};
 
 /// What stands in the test room besides its diffuse walls.
@@ -249,6 +249,62 @@ fn light_sampling_bsdf_sampling_and_mis_converge_to_the_same_image() {
             total(&bsdf)
         );
     }
+}
+
+/// The test room during a shutter: the ceiling light slides and turns in the second half
+/// (so its mean place is not its place at mid-shutter), the floor slides,
+/// and one wall is a deforming mesh in two time slices (each placed differently).
+fn moving_room() -> Scene {
+    let mut scene = test_room(Contents::Glossy);
+    let light = scene
+        .instances
+        .iter()
+        .position(|i| scene.materials[scene.meshes[i.mesh].material].is_emissive())
+        .unwrap();
+    let slide = |x: f32, turn: f32| {
+        Affine3A::from_translation(Vec3::new(x, 0.0, 0.0)) * Affine3A::from_rotation_y(turn)
+    };
+    scene.instances[light].motion =
+        Motion::from_keys(vec![slide(0.0, 0.0), slide(0.0, 0.0), slide(0.6, 0.5)]);
+    scene.instances[0].motion =
+        Motion::from_keys(vec![slide(0.0, 0.0), slide(0.2, 0.0), slide(0.1, 0.0)]);
+    let wall = scene.instances[2].clone();
+    scene.instances[2].slice = Some(TimeSlice::around_key(0, 2));
+    scene.instances.push(Instance {
+        world_from_object: Affine3A::from_translation(Vec3::new(0.0, 0.0, -0.2)),
+        slice: Some(TimeSlice::around_key(1, 2)),
+        ..wall
+    });
+    scene
+}
+
+#[test]
+fn with_motion_blur_light_sampling_bsdf_sampling_and_mis_still_agree() {
+    let scene = moving_room();
+    assert!(scene.has_moving_geometry());
+    let camera = camera_at(3.4, 40.0);
+    let mis = estimate(&scene, &camera, Strategy::Mis, SEEDS, 32, 16);
+    let light = estimate(&scene, &camera, Strategy::LightOnly, SEEDS, 32, 16);
+    let bsdf = estimate(&scene, &camera, Strategy::BsdfOnly, SEEDS, 32, 16);
+    assert_agree("motion: MIS vs light sampling", &mis, &light);
+    assert_agree("motion: MIS vs BSDF sampling", &mis, &bsdf);
+    assert_agree("motion: light vs BSDF sampling", &light, &bsdf);
+    // And the blur is there: the image differs from the still room's.
+    let still = estimate(
+        &test_room(Contents::Glossy),
+        &camera,
+        Strategy::Mis,
+        4,
+        32,
+        16,
+    );
+    assert!(
+        still
+            .0
+            .iter()
+            .zip(&mis.0)
+            .any(|(a, b)| (a - b).abs() > 0.05)
+    );
 }
 
 /// A closed box whose inward-facing walls all emit `le` and reflect with `albedo`.

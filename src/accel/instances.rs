@@ -79,9 +79,10 @@ impl SceneAccel {
                     object_from_world: inst.world_from_object.inverse(),
                     world_bounds: match &inst.motion {
                         None => culling_bounds(&object, &inst.world_from_object),
-                        Some(motion) => motion.keys().iter().fold(Aabb::EMPTY, |b, key| {
-                            b.union(culling_bounds(&object, key))
-                        }),
+                        Some(motion) => motion
+                            .keys()
+                            .iter()
+                            .fold(Aabb::EMPTY, |b, key| b.union(culling_bounds(&object, key))),
                     },
                     motion: inst.motion.clone(),
                     slice: inst.slice,

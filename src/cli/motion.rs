@@ -50,9 +50,14 @@ pub fn apply_shutter(
 ) -> Result<(Loaded, String)> {
     let shutter = match args.shutter {
         Some(shutter) => Some(shutter),
-        None => choose_camera(&loaded.scene, args.camera.as_deref(), args.width, args.height)
-            .ok()
-            .and_then(|camera| camera.shutter),
+        None => choose_camera(
+            &loaded.scene,
+            args.camera.as_deref(),
+            args.width,
+            args.height,
+        )
+        .ok()
+        .and_then(|camera| camera.shutter),
     };
     let Some(shutter) = shutter.filter(|s| s[1] > s[0]) else {
         return Ok((loaded, String::new()));

@@ -95,10 +95,7 @@ pub fn over_shutter(
             .collect();
         let motion = Motion::from_keys(keys);
         match &copies[instance.mesh] {
-            None => instances.push(Instance {
-                motion,
-                ..instance
-            }),
+            None => instances.push(Instance { motion, ..instance }),
             Some(indices) => {
                 for (k, &mesh) in indices.iter().enumerate() {
                     instances.push(Instance {

@@ -148,9 +148,9 @@ impl Renderer<'_> {
 
             // Emission reached by the previous bounce.
             if material.is_emissive() && (front || material.double_sided) {
-                let light_pdf = self
-                    .lights
-                    .pdf(hit.instance, hit.triangle, hit.time, travelled, cos_o);
+                let light_pdf =
+                    self.lights
+                        .pdf(hit.instance, hit.triangle, hit.time, travelled, cos_o);
                 let weight = emission_weight(arrival, strategy, light_pdf);
                 result.radiance += weight * beta * shading.emission;
             }

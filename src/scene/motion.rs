@@ -55,9 +55,21 @@ impl Motion {
     pub fn largest_step(&self, object: &Aabb) -> f32 {
         let corners = (0..8).map(|i| {
             Vec3A::new(
-                if i & 1 == 0 { object.min.x } else { object.max.x },
-                if i & 2 == 0 { object.min.y } else { object.max.y },
-                if i & 4 == 0 { object.min.z } else { object.max.z },
+                if i & 1 == 0 {
+                    object.min.x
+                } else {
+                    object.max.x
+                },
+                if i & 2 == 0 {
+                    object.min.y
+                } else {
+                    object.max.y
+                },
+                if i & 4 == 0 {
+                    object.min.z
+                } else {
+                    object.max.z
+                },
             )
         });
         corners
@@ -135,7 +147,11 @@ mod tests {
         let slices: Vec<TimeSlice> = (0..5).map(|i| TimeSlice::around_key(i, 5)).collect();
         for k in 0..=1000 {
             let t = k as f32 / 1000.0;
-            assert_eq!(slices.iter().filter(|s| s.contains(t)).count(), 1, "t = {t}");
+            assert_eq!(
+                slices.iter().filter(|s| s.contains(t)).count(),
+                1,
+                "t = {t}"
+            );
         }
         assert!(slices[2].contains(0.5) && !slices[2].contains(0.625));
     }

@@ -53,9 +53,18 @@ impl UsdLoader {
                 }
             });
         // Frame-relative shutter interval (UsdGeomCamera; both 0 by default: no blur).
-        let open = self.get(prim, "shutter:open").as_ref().and_then(as_f64).unwrap_or(0.0);
-        let close = self.get(prim, "shutter:close").as_ref().and_then(as_f64).unwrap_or(0.0);
-        let shutter = (open.is_finite() && close.is_finite() && close > open).then_some([open, close]);
+        let open = self
+            .get(prim, "shutter:open")
+            .as_ref()
+            .and_then(as_f64)
+            .unwrap_or(0.0);
+        let close = self
+            .get(prim, "shutter:close")
+            .as_ref()
+            .and_then(as_f64)
+            .unwrap_or(0.0);
+        let shutter =
+            (open.is_finite() && close.is_finite() && close > open).then_some([open, close]);
         self.builder.add_camera(Camera {
             name: where_.clone(),
             world_from_camera: Affine3A::from_rotation_translation(

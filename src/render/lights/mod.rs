@@ -55,10 +55,18 @@ impl PlacedTriangle {
         let cross = (p1 - p0).cross(p2 - p0);
         let area = 0.5 * cross.length();
         let usable = area.is_finite() && area > 0.0;
-        let sign = if m.matrix3.determinant() < 0.0 { -1.0 } else { 1.0 };
+        let sign = if m.matrix3.determinant() < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
         PlacedTriangle {
             corners,
-            normal: if usable { sign * cross / (2.0 * area) } else { Vec3::Z },
+            normal: if usable {
+                sign * cross / (2.0 * area)
+            } else {
+                Vec3::Z
+            },
             area: if usable { area } else { 0.0 },
         }
     }
