@@ -328,8 +328,15 @@ mod tests {
     fn a_record_survives_its_text() {
         let record = record();
         let text = record.to_text();
-        assert_eq!(text.lines().count(), 12, "one line per field:\n{text}");
-        assert_eq!(RenderRecord::from_text(&text), Ok(record));
+        assert_eq!(text.lines().count(), 13, "one line per field:\n{text}");
+        assert_eq!(RenderRecord::from_text(&text), Ok(record.clone()));
+        // Records from before --exposure read as 0 stops.
+        let old: String = text
+            .lines()
+            .filter(|l| !l.starts_with("exposure="))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        assert_eq!(RenderRecord::from_text(&old).unwrap().identity.exposure, 0.0);
     }
 
     #[test]
