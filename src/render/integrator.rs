@@ -9,7 +9,8 @@ use glam::Vec3;
 
 use super::Renderer;
 use super::bsdf::Bsdf;
-use super::sampling::{Rng, power_heuristic};
+use super::sampler::Sampler;
+use super::sampling::power_heuristic;
 use super::surface::{Surface, offset_ray_origin, surface_at};
 use crate::accel::Ray;
 
@@ -60,7 +61,7 @@ impl Renderer<'_> {
     pub fn trace_path(
         &self,
         mut ray: Ray,
-        rng: &mut Rng,
+        sampler: &mut Sampler,
         max_depth: u32,
         strategy: Strategy,
     ) -> PathResult {
@@ -119,7 +120,7 @@ impl Renderer<'_> {
             let s = surface_at(self.scene, &self.frames, &hit);
             let material = &self.scene.materials[s.material];
             let hidden = depth == 0 && !material.camera_visible;
-            if hidden || !self.is_present(&s, rng) {
+            if hidden || !self.is_present(&s, sampler) {
                 // A cutout, a blended surface the ray passes or a surface the camera does
                 // not see: go on in the same direction.
                 pass_throughs += 1;
@@ -150,7 +151,7 @@ impl Renderer<'_> {
             if material.is_emissive() && (front || material.double_sided) {
                 let light_pdf =
                     self.lights
-                        .pdf(hit.instance, hit.triangle, hit.time, travelled, cos_o);
+                        .pdf(hit.instance, hit.triangle, hit.time, vertex, travelled, cos_o);
                 let weight = emission_weight(arrival, strategy, light_pdf);
                 result.radiance += weight * beta * shading.emission;
             }
@@ -180,11 +181,11 @@ impl Renderer<'_> {
                 && (strategy != Strategy::BsdfOnly || self.lights.punctual_len() > 0)
             {
                 result.rays += 1;
-                result.radiance += beta * self.direct_light(&bsdf, &s, ng, ns, wo, rng, strategy);
+                result.radiance += beta * self.direct_light(&bsdf, &s, ng, ns, wo, sampler, strategy);
             }
 
             // Sample the BSDF to extend the path.
-            let Some(sample) = bsdf.sample(ns, wo, rng.uniform2(), rng.uniform()) else {
+            let Some(sample) = bsdf.sample(ns, wo, sampler.uniform2(), sampler.uniform()) else {
                 break;
             };
             let side = sample.wi.dot(ng);
@@ -219,7 +220,7 @@ impl Renderer<'_> {
                 let rr = (beta / eta_scale).max_element();
                 if rr < 1.0 {
                     let q = (1.0 - rr).clamp(0.05, 0.95);
-                    if rng.uniform() < q {
+                    if sampler.uniform() < q {
                         break;
                     }
                     beta /= 1.0 - q;
@@ -244,11 +245,11 @@ impl Renderer<'_> {
         ng: Vec3,
         ns: Vec3,
         wo: Vec3,
-        rng: &mut Rng,
+        sampler: &mut Sampler,
         strategy: Strategy,
     ) -> Vec3 {
-        let u_light = rng.uniform();
-        let u = rng.uniform2();
+        let u_light = sampler.uniform();
+        let u = sampler.uniform2();
         let sample = if strategy == Strategy::BsdfOnly {
             self.lights.sample_punctual(s.point, u_light)
         } else {
@@ -277,7 +278,7 @@ impl Renderer<'_> {
             t_max: 1.0 - SHADOW_EPSILON,
             time: s.time,
         };
-        if self.occluded(&shadow, rng) {
+        if self.occluded(&shadow, sampler) {
             return Vec3::ZERO;
         }
         let weight = match strategy {
@@ -289,7 +290,7 @@ impl Renderer<'_> {
 
     /// True when something blocks `shadow`. Surfaces that alpha hides do not; when the scene
     /// has any, the segment is walked hit by hit.
-    fn occluded(&self, shadow: &Ray, rng: &mut Rng) -> bool {
+    fn occluded(&self, shadow: &Ray, sampler: &mut Sampler) -> bool {
         if !self.has_cutouts {
             return self.accel.occluded(shadow);
         }
@@ -299,7 +300,7 @@ impl Renderer<'_> {
                 return false;
             };
             let s = surface_at(self.scene, &self.frames, &hit);
-            if self.is_present(&s, rng) {
+            if self.is_present(&s, sampler) {
                 return true;
             }
             // Go on from just past this surface towards the same end point.

@@ -9,6 +9,7 @@ mod film;
 mod filter;
 mod integrator;
 mod lights;
+pub mod sampler;
 pub mod sampling;
 mod shading;
 mod surface;
@@ -28,7 +29,8 @@ use rayon::prelude::*;
 
 use crate::accel::SceneAccel;
 use crate::scene::{Camera, Scene};
-use sampling::{Rng, mix64};
+use sampler::Sampler;
+use sampling::mix64;
 use surface::InstanceFrame;
 
 /// What to render and how.
@@ -148,7 +150,7 @@ impl<'a> Renderer<'a> {
     /// ([`Image::spp`]).
     ///
     /// Every sample draws from its own random stream, keyed by the seed, the pixel index and
-    /// the sample index ([`Rng::for_sample`]), and each pixel sums its samples in a fixed
+    /// the sample index ([`Sampler::for_sample`]), and each pixel sums its samples in a fixed
     /// order, so the image is bit-identical for any number of threads, and a sample is the
     /// same whichever process renders it.
     pub fn render_until(
@@ -190,21 +192,21 @@ impl<'a> Renderer<'a> {
                     let mut rays = 0u64;
                     for (x, acc) in row.iter_mut().enumerate() {
                         let pixel = (y * width + x) as u64;
-                        let mut rng = Rng::for_sample(seed, pixel, sample);
-                        let at = filter.sample(rng.uniform2());
+                        let mut sampler = Sampler::for_sample(seed, pixel, sample);
+                        let at = filter.sample(sampler.uniform2());
                         // A lens position only when there is a lens, so pinhole images keep
                         // their random streams.
                         let lens = if generator.has_lens() {
-                            rng.uniform2()
+                            sampler.uniform2()
                         } else {
                             glam::Vec2::splat(0.5)
                         };
                         // A shutter time only when something moves, likewise.
-                        let time = if timed { rng.uniform() } else { 0.0 };
+                        let time = if timed { sampler.uniform() } else { 0.0 };
                         let (px, py) = (x as f32 + at.x, y as f32 + at.y);
                         let ray = generator.generate_through_lens(px, py, lens, time);
                         let path =
-                            self.trace_path(ray, &mut rng, settings.max_depth, settings.strategy);
+                            self.trace_path(ray, &mut sampler, settings.max_depth, settings.strategy);
                         rays += path.rays;
                         acc.add(path.radiance, path.hit);
                     }

@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3, Vec4};
 
 use super::Renderer;
 use super::bsdf::Bsdf;
-use super::sampling::Rng;
+use super::sampler::Sampler;
 use super::surface::Surface;
 use crate::scene::{AlphaMode, ChannelRef, ColorSpace, Material, Mesh, Scene, TextureRef};
 
@@ -114,12 +114,12 @@ impl Renderer<'_> {
 
     /// True when the surface at `s` is really there for a ray: cutouts (alpha mask) are
     /// holes, and a blended surface is there with probability alpha.
-    pub(super) fn is_present(&self, s: &Surface, rng: &mut Rng) -> bool {
+    pub(super) fn is_present(&self, s: &Surface, sampler: &mut Sampler) -> bool {
         let material = &self.scene.materials[s.material];
         match material.alpha_mode {
             AlphaMode::Opaque => true,
             AlphaMode::Mask { cutoff } => self.alpha_at(material, s) >= cutoff,
-            AlphaMode::Blend => rng.uniform() < self.alpha_at(material, s),
+            AlphaMode::Blend => sampler.uniform() < self.alpha_at(material, s),
         }
     }
 

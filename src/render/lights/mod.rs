@@ -5,6 +5,7 @@
 
 mod environment;
 mod sphere;
+mod spherical;
 
 use std::collections::HashMap;
 
@@ -294,8 +295,9 @@ impl LightSet {
         }
     }
 
-    /// A uniform point on triangle `index`; the area density is turned into solid angle by
-    /// distance²/|cos θ_light|.
+    /// A point on triangle `index`: uniform over the solid angle it subtends at `p` where
+    /// that is well conditioned ([`spherical`]), else uniform over its area, the density
+    /// turned into solid angle by distance²/|cos θ_light|.
     fn sample_triangle(
         &self,
         scene: &Scene,
@@ -310,7 +312,14 @@ impl LightSet {
         if placed.area == 0.0 {
             return None;
         }
-        let b = uniform_triangle(u);
+        let corners = placed.corners.map(|c| c.0);
+        let omega = spherical::solid_angle(p, corners);
+        let by_solid_angle = spherical::use_solid_angle(omega);
+        let b = if by_solid_angle {
+            spherical::sample(p, corners, u)?.1
+        } else {
+            uniform_triangle(u)
+        };
         let (point, point_error) =
             interpolate_with_error(placed.corners, [1.0 - b.x - b.y, b.x, b.y]);
         let to_light = point - p;
@@ -324,7 +333,11 @@ impl LightSet {
         if cos_light == 0.0 {
             return None;
         }
-        let pdf = pmf / placed.area * distance_sq / cos_light.abs();
+        let pdf = if by_solid_angle {
+            pmf / omega as f32
+        } else {
+            pmf / placed.area * distance_sq / cos_light.abs()
+        };
         let mut radiance = if tri.double_sided || cos_light > 0.0 {
             tri.radiance
         } else {
@@ -492,14 +505,16 @@ impl LightSet {
         !self.spheres.is_empty()
     }
 
-    /// The solid-angle density with which [`LightSet::sample`] would pick the point of
-    /// triangle `triangle` of instance `instance` at `distance` and light cosine `cos_light`.
+    /// The solid-angle density with which [`LightSet::sample`] at `origin` would pick the
+    /// point of triangle `triangle` of instance `instance` at `distance` and light cosine
+    /// `cos_light`.
     /// `time` is the shutter time of the ray that hit it.
     pub fn pdf(
         &self,
         instance: u32,
         triangle: u32,
         time: f32,
+        origin: Vec3,
         distance: f32,
         cos_light: f32,
     ) -> f32 {
@@ -513,7 +528,12 @@ impl LightSet {
         if placed.area == 0.0 || cos_light == 0.0 {
             return 0.0;
         }
-        self.distribution.pmf(index) / placed.area * distance * distance / cos_light.abs()
+        let pmf = self.distribution.pmf(index);
+        let omega = spherical::solid_angle(origin, placed.corners.map(|c| c.0));
+        if spherical::use_solid_angle(omega) {
+            return pmf / omega as f32;
+        }
+        pmf / placed.area * distance * distance / cos_light.abs()
     }
 
     /// Where `tri` is at shutter time `time`, or `None` when it is not there then (a time

@@ -1,0 +1,218 @@
+//! The numbers one camera sample draws: Owen-scrambled Sobol points, padded by dimension
+//! sets (Burley 2020, "Practical Hash-based Owen Scrambling", JCGT 9(4)).
+//!
+//! Each request — one number or a pair — takes the next *dimension set* of the sample. A
+//! set reads the first one or two Sobol dimensions (the (0, 2)-sequence in base 2) at the
+//! sample's index, after the index is shuffled and the values scrambled by hashes of
+//! (seed, pixel, set), so:
+//! - over a pixel's samples 0 … 2^k − 1, every set is stratified: a pair forms a
+//!   (0, k, 2)-net, one number falls once in each interval of length 2^−k — also for any
+//!   aligned range `A..B` of sample indices with power-of-two length, as `--samples`
+//!   splits usually are;
+//! - sets are scrambled independently, so the dimensions a path uses at its bounces are
+//!   uncorrelated whatever it consumed before ("padding");
+//! - sample *i* of pixel *p* depends on (seed, p, i) alone: the same numbers whichever
+//!   thread, pass or process takes it, so split renders merge exactly.
+//!
+//! A path asks for its sets in this order: pixel filter (pair), lens (pair, when there is
+//! one), shutter time (one, when something moves), then per vertex: alpha tests (one
+//! each, when a surface is blended), light choice (one) and point on it (pair), BSDF lobe
+//! (one) and direction (pair), Russian roulette (one).
+
+use glam::Vec2;
+
+use super::sampling::mix64;
+
+/// Where a camera sample is in its sequence.
+#[derive(Clone, Debug)]
+pub struct Sampler {
+    /// Hash of (seed, pixel): the scrambles of this pixel's sets derive from it.
+    pixel_seed: u32,
+    /// The sample's index among all of the pixel's samples.
+    index: u32,
+    /// The next dimension set.
+    set: u32,
+}
+
+impl Sampler {
+    /// The sequence of sample `sample` of pixel `pixel`, for seed `seed`.
+    pub fn for_sample(seed: u64, pixel: u64, sample: u32) -> Sampler {
+        Sampler {
+            pixel_seed: mix64(mix64(seed) ^ pixel) as u32,
+            index: sample,
+            set: 0,
+        }
+    }
+
+    /// One number in [0, 1), stratified over the pixel's samples.
+    pub fn uniform(&mut self) -> f32 {
+        let seed = self.next_set_seed();
+        let index = nested_uniform_scramble(self.index, seed);
+        to_unit(nested_uniform_scramble(
+            index.reverse_bits(),
+            hash_combine(seed, 1),
+        ))
+    }
+
+    /// Two numbers in [0, 1)², jointly stratified over the pixel's samples.
+    pub fn uniform2(&mut self) -> Vec2 {
+        let seed = self.next_set_seed();
+        let index = nested_uniform_scramble(self.index, seed);
+        Vec2::new(
+            to_unit(nested_uniform_scramble(
+                index.reverse_bits(),
+                hash_combine(seed, 1),
+            )),
+            to_unit(nested_uniform_scramble(
+                sobol_second(index),
+                hash_combine(seed, 2),
+            )),
+        )
+    }
+
+    fn next_set_seed(&mut self) -> u32 {
+        let seed = hash_combine(self.pixel_seed, self.set);
+        self.set += 1;
+        seed
+    }
+}
+
+/// The second Sobol dimension at `index`: generator matrix from the primitive polynomial
+/// x + 1 (direction numbers v₀ = 2³¹, vᵢ = vᵢ₋₁ ⊕ (vᵢ₋₁ ≫ 1)).
+fn sobol_second(index: u32) -> u32 {
+    let mut x = 0;
+    let mut v = 1u32 << 31;
+    let mut i = index;
+    while i != 0 {
+        if i & 1 == 1 {
+            x ^= v;
+        }
+        i >>= 1;
+        v ^= v >> 1;
+    }
+    x
+}
+
+/// Owen scrambling of the bits of `x` as a nested uniform scramble: each bit flipped by a
+/// hash of the bits above it (Burley 2020, §3: the Laine–Karras permutation on reversed
+/// bits, with Burley's improved constants).
+fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
+    let mut v = x.reverse_bits();
+    v = v.wrapping_add(seed);
+    v ^= v.wrapping_mul(0x6c50_b47c);
+    v ^= v.wrapping_mul(0xb82f_1e52);
+    v ^= v.wrapping_mul(0xc7af_e638);
+    v ^= v.wrapping_mul(0x8d22_f6e6);
+    v.reverse_bits()
+}
+
+/// Burley's hash_combine (after Boost): a seed for a sub-stream.
+fn hash_combine(seed: u32, v: u32) -> u32 {
+    let h = mix64(u64::from(v)) as u32;
+    seed ^ (h
+        .wrapping_add(0x9e37_79b9)
+        .wrapping_add(seed << 6)
+        .wrapping_add(seed >> 2))
+}
+
+/// The top 24 bits as a float in [0, 1).
+fn to_unit(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every elementary interval of area 2^−k holds exactly one of 2^k points.
+    fn is_net(points: &[Vec2], k: u32) -> bool {
+        (0..=k).all(|bits_x| {
+            let (nx, ny) = (1usize << bits_x, 1usize << (k - bits_x));
+            let mut seen = vec![false; nx * ny];
+            points.iter().all(|p| {
+                let cell = (p.y * ny as f32) as usize * nx + (p.x * nx as f32) as usize;
+                !std::mem::replace(&mut seen[cell], true)
+            })
+        })
+    }
+
+    #[test]
+    fn each_pair_of_a_pixels_samples_is_a_net_for_aligned_power_of_two_ranges() {
+        for pixel in 0..20u64 {
+            for (start, k) in [(0u32, 4u32), (0, 8), (64, 6), (256, 8), (4096, 10)] {
+                for set in 0..6 {
+                    let points: Vec<Vec2> = (start..start + (1 << k))
+                        .map(|i| {
+                            let mut s = Sampler::for_sample(7, pixel, i);
+                            for _ in 0..set {
+                                s.uniform2();
+                            }
+                            s.uniform2()
+                        })
+                        .collect();
+                    assert!(is_net(&points, k), "pixel {pixel}, samples {start}+2^{k}, set {set}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn single_numbers_fall_once_in_each_stratum() {
+        for pixel in 0..50u64 {
+            let mut seen = [false; 256];
+            for i in 0..256 {
+                let mut s = Sampler::for_sample(3, pixel, i);
+                s.uniform2();
+                let u = s.uniform();
+                assert!(!std::mem::replace(&mut seen[(u * 256.0) as usize], true));
+            }
+        }
+    }
+
+    /// Pearson's χ² over `bins` equally likely bins, against the 99.99 % point of its
+    /// distribution (Wilson–Hilferty).
+    fn chi_square_ok(counts: &[u64]) -> (f64, f64) {
+        let n: u64 = counts.iter().sum();
+        let expected = n as f64 / counts.len() as f64;
+        let chi: f64 = counts
+            .iter()
+            .map(|&c| (c as f64 - expected).powi(2) / expected)
+            .sum();
+        let dof = (counts.len() - 1) as f64;
+        let z = 3.719;
+        let limit = dof * (1.0 - 2.0 / (9.0 * dof) + z * (2.0 / (9.0 * dof)).sqrt()).powi(3);
+        (chi, limit)
+    }
+
+    #[test]
+    fn pixels_and_sets_are_independent() {
+        // The same sample of many pixels is uniform, and a set is not tied to the next one:
+        // (set 1's x, set 2's y) over pixels fills the square evenly.
+        let bins = 16;
+        let mut marginal = vec![0u64; bins];
+        let mut joint = vec![0u64; bins * bins];
+        for pixel in 0..200_000u64 {
+            let mut s = Sampler::for_sample(11, pixel, 5);
+            s.uniform2();
+            let a = s.uniform2().x;
+            let b = s.uniform2().y;
+            marginal[(a * bins as f32) as usize] += 1;
+            joint[(b * bins as f32) as usize * bins + (a * bins as f32) as usize] += 1;
+        }
+        for counts in [&marginal, &joint] {
+            let (chi, limit) = chi_square_ok(counts);
+            assert!(chi < limit, "χ² {chi:.1} over the 99.99 % point {limit:.1}");
+        }
+    }
+
+    #[test]
+    fn a_sample_depends_on_seed_pixel_and_index_alone() {
+        let draw = |seed, pixel, i| {
+            let mut s = Sampler::for_sample(seed, pixel, i);
+            (s.uniform2(), s.uniform(), s.uniform2())
+        };
+        assert_eq!(draw(1, 2, 3), draw(1, 2, 3));
+        assert_ne!(draw(1, 2, 3), draw(2, 2, 3));
+        assert_ne!(draw(1, 2, 3), draw(1, 3, 3));
+    }
+}

@@ -1,0 +1,126 @@
+"""Sampling efficiency against Cycles: error against each Cycles reference versus time.
+
+Run from the repository root after `cargo build --release`, with the PyPI `bpy` package
+(Blender as a Python module) and numpy and OpenEXR:
+
+    pip install bpy==5.0.1 numpy OpenEXR
+    python3 tools/blender/efficiency.py [--spp 16 64] [--only NAME] [--gridtrace PATH]
+
+For each reference scene of make_references.py (128x128, box filter, 64 bounces, black
+world, materials replaced by gridtrace's models), both renderers render it at each sample
+count in this one run, on the same cores (Cycles: CPU, threads auto; gridtrace: one thread
+per core). Error is the mean squared error against the reference's mean (the two halves in
+tests/references), less the reference's own noise (the halves' squared difference / 4);
+time is the time spent sampling: gridtrace's reported render time (loading excluded), and
+for Cycles the time of the N-sample render less that of a 1-sample render (scene sync and
+BVH build), scaled by N / (N - 1). Efficiency is 1 / (MSE x time); the table gives both
+renderers' figures and their ratio (gridtrace / Cycles, higher is better).
+"""
+
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+import OpenEXR
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bpy  # noqa: E402
+from make_cornell import reset  # noqa: E402
+from make_references import (  # noqa: E402
+    REFERENCES, ROOT, SCENE_TABLE, configure_cycles, use_exact_models,
+)
+
+
+def read_rgb(path):
+    f = OpenEXR.File(path)
+    channels = f.parts[0].channels
+    if "RGBA" in channels:
+        return np.asarray(channels["RGBA"].pixels, dtype=np.float64)[..., :3]
+    if "RGB" in channels:
+        return np.asarray(channels["RGB"].pixels, dtype=np.float64)
+    return np.stack([np.asarray(channels[c].pixels, dtype=np.float64) for c in "RGB"], axis=-1)
+
+
+def reference(name):
+    a = read_rgb(os.path.join(REFERENCES, f"{name}_a.exr"))
+    b = read_rgb(os.path.join(REFERENCES, f"{name}_b.exr"))
+    return 0.5 * (a + b), float(np.mean((a - b) ** 2) / 4.0)
+
+
+def cycles_render(scene, spp, seed, out):
+    configure_cycles(scene, spp, seed)
+    scene.render.filepath = out
+    start = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    return time.perf_counter() - start
+
+
+def gridtrace_render(binary, scene_file, spp, seed, out):
+    result = subprocess.run(
+        [binary, scene_file, "-o", out, "--spp", str(spp), "--seed", str(seed),
+         "--max-depth", "64", "--width", "128", "--height", "128"],
+        capture_output=True, text=True, check=True)
+    seconds = re.search(r" in ([0-9.]+) s:", result.stderr)
+    return float(seconds.group(1))
+
+
+def scene_file(name):
+    _, directory, _ = SCENE_TABLE[name]
+    return os.path.join(directory, f"{name}.glb")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--spp", type=int, nargs="+", default=[16, 64])
+    parser.add_argument("--only", action="append", help="scene name (repeatable)")
+    parser.add_argument("--repeats", type=int, default=2, help="renders per measurement (seeds)")
+    parser.add_argument("--gridtrace", default=os.path.join(ROOT, "target", "release", "gridtrace"))
+    args = parser.parse_args()
+    names = [n for n, (_, _, s) in SCENE_TABLE.items() if s > 0 and (not args.only or n in args.only)]
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "out.exr")
+        for name in names:
+            ref, ref_noise = reference(name)
+            scene = reset()
+            SCENE_TABLE[name][0](scene)
+            for mat in bpy.data.materials:
+                if mat.node_tree and mat.node_tree.nodes.get("Principled BSDF"):
+                    use_exact_models(mat)
+            overhead = min(cycles_render(scene, 1, 100 + r, out) for r in range(args.repeats))
+            for spp in args.spp:
+                measured = {}
+                for who in ("gridtrace", "cycles"):
+                    errors, times = [], []
+                    for r in range(args.repeats):
+                        seed = 10 + r
+                        if who == "cycles":
+                            t = (cycles_render(scene, spp, seed, out) - overhead) * spp / (spp - 1)
+                        else:
+                            t = gridtrace_render(args.gridtrace, scene_file(name), spp, seed, out)
+                        errors.append(max(np.mean((read_rgb(out) - ref) ** 2) - ref_noise, 1e-12))
+                        times.append(max(t, 1e-3))
+                    mse, seconds = float(np.mean(errors)), float(np.mean(times))
+                    measured[who] = (mse, seconds, 1.0 / (mse * seconds))
+                rows.append((name, spp, measured))
+                g, c = measured["gridtrace"], measured["cycles"]
+                print(f"{name} {spp} spp: gridtrace MSE {g[0]:.3g} in {g[1]:.2f} s, "
+                      f"Cycles MSE {c[0]:.3g} in {c[1]:.2f} s, efficiency ratio {g[2] / c[2]:.2f}",
+                      flush=True)
+    print()
+    print("| scene | spp | gridtrace MSE | gridtrace s | Cycles MSE | Cycles s | MSE ratio (Cycles / gridtrace) | efficiency ratio (gridtrace / Cycles) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name, spp, m in rows:
+        g, c = m["gridtrace"], m["cycles"]
+        print(f"| {name} | {spp} | {g[0]:.3g} | {g[1]:.2f} | {c[0]:.3g} | {c[1]:.2f} | "
+              f"{c[0] / g[0]:.2f} | {g[2] / c[2]:.2f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
