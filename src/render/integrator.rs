@@ -78,6 +78,8 @@ impl Renderer<'_> {
         // Where the path last scattered (the camera at first): light densities are seen
         // from there.
         let mut vertex = ray.origin;
+        // Its shading normal, which the light tree weighs lights with (none at the camera).
+        let mut vertex_normal = Vec3::ZERO;
         loop {
             result.rays += 1;
             let hit = self.accel.intersect(&ray);
@@ -88,6 +90,7 @@ impl Renderer<'_> {
                 let (origin, d) = (ray.origin, ray.direction / length);
                 self.lights.spheres_along(
                     vertex,
+                    vertex_normal,
                     origin,
                     d,
                     t_max,
@@ -102,7 +105,7 @@ impl Renderer<'_> {
             let Some(hit) = hit else {
                 // The path leaves the scene: the environment, weighed like any emitter,
                 // unless it is hidden from camera rays.
-                let (environment, light_pdf) = self.lights.environment(ray.direction);
+                let (environment, light_pdf) = self.lights.environment(vertex, vertex_normal, ray.direction);
                 if depth == 0 && !self.environment_visible {
                     break;
                 }
@@ -151,7 +154,15 @@ impl Renderer<'_> {
             if material.is_emissive() && (front || material.double_sided) {
                 let light_pdf =
                     self.lights
-                        .pdf(hit.instance, hit.triangle, hit.time, vertex, travelled, cos_o);
+                        .pdf(
+                        hit.instance,
+                        hit.triangle,
+                        hit.time,
+                        vertex,
+                        vertex_normal,
+                        travelled,
+                        cos_o,
+                    );
                 let weight = emission_weight(arrival, strategy, light_pdf);
                 result.radiance += weight * beta * shading.emission;
             }
@@ -210,6 +221,7 @@ impl Renderer<'_> {
             )
             .at_time(s.time);
             vertex = s.point;
+            vertex_normal = ns;
             travelled = 0.0;
             depth += 1;
             pass_throughs = 0;
@@ -253,7 +265,7 @@ impl Renderer<'_> {
         let sample = if strategy == Strategy::BsdfOnly {
             self.lights.sample_punctual(s.point, u_light)
         } else {
-            self.lights.sample(self.scene, s.point, s.time, u_light, u)
+            self.lights.sample(self.scene, s.point, ns, s.time, u_light, u)
         };
         let Some(ls) = sample else {
             return Vec3::ZERO;

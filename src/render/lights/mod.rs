@@ -6,6 +6,7 @@
 mod environment;
 mod sphere;
 mod spherical;
+mod tree;
 
 use std::collections::HashMap;
 
@@ -16,7 +17,8 @@ pub use environment::EnvironmentLight;
 use super::sampling::{Distribution1d, uniform_triangle};
 use super::shading::vertex_uv;
 use super::surface::{interpolate_with_error, transform_point_with_error};
-use crate::scene::{ColorSpace, LightKind, Motion, Scene, TextureRef, TimeSlice};
+use crate::scene::{Aabb, ColorSpace, LightKind, Motion, Scene, TextureRef, TimeSlice};
+use tree::{Cone, LightBounds, LightTree, TreeInput};
 
 /// One emitting triangle in world space.
 #[derive(Clone, Copy, Debug)]
@@ -115,8 +117,10 @@ pub struct LightSet {
     environment: Option<EnvironmentLight>,
     /// What each entry of `distribution` is.
     lights: Vec<Light>,
-    /// Over `lights`, by power.
+    /// Over `lights`, by power: the scene's total, and whether anything emits.
     distribution: Distribution1d,
+    /// Chooses among `lights` for each shading point.
+    tree: LightTree,
     /// Index of the environment in `lights`, if it sends light.
     environment_index: Option<usize>,
     /// Over the delta lights alone (spheres weigh nothing), for estimators that find the
@@ -197,6 +201,7 @@ impl LightSet {
             environment,
             lights,
             distribution: Distribution1d::new(Vec::new()),
+            tree: LightTree::default(),
             environment_index,
             punctual_distribution: Distribution1d::new(Vec::new()),
             spheres: Vec::new(),
@@ -213,11 +218,18 @@ impl LightSet {
                 mean.truncate().element_sum() / 3.0
             })
         };
-        let weights = set
+        let weights: Vec<f32> = set
             .lights
             .iter()
             .map(|&light| set.power(light, &mut texture_mean))
             .collect();
+        let bounds: Vec<TreeInput> = set
+            .lights
+            .iter()
+            .zip(&weights)
+            .map(|(&light, &power)| set.bounds(light, power))
+            .collect();
+        set.tree = LightTree::build(&bounds);
         set.distribution = Distribution1d::new(weights);
         set.punctual_distribution = Distribution1d::new(
             set.punctual
@@ -232,6 +244,84 @@ impl LightSet {
             .filter(|&i| matches!(set.punctual[i], LightKind::Sphere { .. }))
             .collect();
         set
+    }
+
+    /// Where `light` can send light from and to, for the light tree; for a light at
+    /// infinity, the irradiance it brings (its power is what crosses the scene's disc). A
+    /// moving triangle is bounded over the whole shutter, with any normal.
+    fn bounds(&self, light: Light, power: f32) -> TreeInput {
+        let disc = std::f32::consts::PI * self.scene_radius * self.scene_radius;
+        let infinite = TreeInput::Infinite(if disc > 0.0 { power / disc } else { power });
+        let at = |p: Vec3| Aabb { min: p, max: p };
+        let surface = |bounds, normals, two_sided| LightBounds {
+            bounds,
+            power,
+            normals,
+            cos_emission: 0.0,
+            two_sided,
+        };
+        TreeInput::Placed(match light {
+            Light::Triangle(i) => {
+                let t = &self.triangles[i];
+                let corners = |p: &PlacedTriangle| {
+                    p.corners
+                        .iter()
+                        .fold(Aabb::EMPTY, |b, c| b.union(at(c.0)))
+                };
+                match t.moving {
+                    None => surface(
+                        corners(&t.placed),
+                        Cone {
+                            axis: t.placed.normal,
+                            cos_angle: 1.0,
+                        },
+                        t.double_sided,
+                    ),
+                    Some((object, k)) => surface(
+                        self.motions[k as usize]
+                            .keys()
+                            .iter()
+                            .fold(Aabb::EMPTY, |b, key| {
+                                b.union(corners(&PlacedTriangle::new(key, object)))
+                            }),
+                        Cone::ALL,
+                        true,
+                    ),
+                }
+            }
+            Light::Environment => return infinite,
+            Light::Punctual(i) => match self.punctual[i] {
+                LightKind::Directional { .. } => return infinite,
+                LightKind::Point { position, .. } => surface(at(position), Cone::ALL, false),
+                LightKind::Spot {
+                    position,
+                    direction,
+                    cos_outer,
+                    ..
+                } => LightBounds {
+                    // Nothing beyond the outer cone.
+                    cos_emission: 1.0,
+                    ..surface(
+                        at(position),
+                        Cone {
+                            axis: direction,
+                            cos_angle: cos_outer,
+                        },
+                        false,
+                    )
+                },
+                LightKind::Sphere {
+                    position, radius, ..
+                } => surface(
+                    Aabb {
+                        min: position - Vec3::splat(radius),
+                        max: position + Vec3::splat(radius),
+                    },
+                    Cone::ALL,
+                    false,
+                ),
+            },
+        })
     }
 
     /// Emitted power of one light (W, mean over channels), for choosing among them; a
@@ -276,18 +366,19 @@ impl LightSet {
         self.environment.as_ref()
     }
 
-    /// Draws a point on a light for shading point `p`: a light by power, then a point on it
-    /// by that light's own rule.
-    /// `time` is the path's shutter time, for lights that move.
+    /// Draws a point on a light for shading point `p` with shading normal `n`: a light from
+    /// the light tree, then a point on it by that light's own rule. `time` is the path's
+    /// shutter time, for lights that move.
     pub fn sample(
         &self,
         scene: &Scene,
         p: Vec3,
+        n: Vec3,
         time: f32,
         u_light: f32,
         u: Vec2,
     ) -> Option<LightSample> {
-        let (index, pmf) = self.distribution.sample(u_light)?;
+        let (index, pmf) = self.tree.choose(p, n, u_light)?;
         match self.lights[index] {
             Light::Triangle(i) => self.sample_triangle(scene, i, pmf, p, time, u),
             Light::Punctual(i) => self.sample_punctual_light(i, pmf, p, u),
@@ -382,15 +473,16 @@ impl LightSet {
         2.0 * self.scene_radius + p.distance(self.scene_center) + 1.0
     }
 
-    /// Radiance of the environment seen along `direction` by a ray that left the scene, and
-    /// the solid-angle density with which [`LightSet::sample`] would have drawn it.
-    pub fn environment(&self, direction: Vec3) -> (Vec3, f32) {
+    /// Radiance of the environment seen along `direction` by a ray that left the scene from
+    /// `vertex` (shading normal `vertex_normal`), and the solid-angle density with which
+    /// [`LightSet::sample`] there would have drawn it.
+    pub fn environment(&self, vertex: Vec3, vertex_normal: Vec3, direction: Vec3) -> (Vec3, f32) {
         match (&self.environment, self.environment_index) {
             (Some(e), Some(index)) => {
                 let direction = direction.normalize();
                 (
                     e.radiance(direction),
-                    self.distribution.pmf(index) * e.pdf(direction),
+                    self.tree.pmf(index, vertex, vertex_normal) * e.pdf(direction),
                 )
             }
             _ => (Vec3::ZERO, 0.0),
@@ -467,9 +559,11 @@ impl LightSet {
     /// `vertex`) and the distance of every sphere light that a ray from `origin` along unit
     /// direction `d` passes before `t_max`. Spheres are not geometry: the ray goes on
     /// through them. `camera` asks for a camera ray, which sees only spheres visible to it.
+    #[allow(clippy::too_many_arguments)]
     pub fn spheres_along(
         &self,
         vertex: Vec3,
+        vertex_normal: Vec3,
         origin: Vec3,
         d: Vec3,
         t_max: f32,
@@ -493,7 +587,9 @@ impl LightSet {
             }
             if let Some(t) = sphere::intersect(position, radius, origin, d, 0.0, t_max) {
                 let spot = light.spot_factor(-d);
-                let pmf = self.distribution.pmf(self.triangles.len() + i);
+                let pmf = self
+                    .tree
+                    .pmf(self.triangles.len() + i, vertex, vertex_normal);
                 let pdf = pmf * sphere::pdf(position, radius, vertex);
                 found(radiance * spot, pdf, t);
             }
@@ -515,6 +611,7 @@ impl LightSet {
         triangle: u32,
         time: f32,
         origin: Vec3,
+        origin_normal: Vec3,
         distance: f32,
         cos_light: f32,
     ) -> f32 {
@@ -528,7 +625,10 @@ impl LightSet {
         if placed.area == 0.0 || cos_light == 0.0 {
             return 0.0;
         }
-        let pmf = self.distribution.pmf(index);
+        let pmf = self.tree.pmf(index, origin, origin_normal);
+        if pmf == 0.0 {
+            return 0.0;
+        }
         let omega = spherical::solid_angle(origin, placed.corners.map(|c| c.0));
         if spherical::use_solid_angle(omega) {
             return pmf / omega as f32;

@@ -1,0 +1,444 @@
+//! Choosing a light for a shading point with a light tree (Conty Estevez & Kulla 2018,
+//! "Importance Sampling of Many Lights", as pbrt-v4's `BVHLightSampler` formulates it):
+//! the lights with a position sit in a binary tree whose nodes bound their lights' places,
+//! emitting directions and power; from the root, each step goes to a child with
+//! probability proportional to an importance that no light inside can exceed — power over
+//! squared distance, times the best cosines the bounds allow at the light and at the
+//! receiver — so a point spends its samples on the lights that can matter there, and never
+//! on a light whose bounds show it cannot reach it (behind a one-sided emitter, outside a
+//! spot's cone).
+//!
+//! Lights at infinity (the environment, a sun) have no place: they compete with the tree's
+//! root by irradiance, theirs against the root's importance taken as the irradiance of its
+//! power seen from there (÷ 2π: between an isotropic point, ÷ 4π, and a facing Lambertian
+//! panel, ÷ π), as Cycles' light tree weighs its distant lights against its local ones by
+//! energy. The probability of any light at any point is recomputed by walking its path
+//! from the root, which MIS needs for lights that bounce rays find.
+
+use glam::{Quat, Vec3};
+
+use crate::scene::Aabb;
+
+/// A cone of directions: unit `axis`, and the cosine of its half-angle (−1: every
+/// direction).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cone {
+    /// The cone's axis.
+    pub axis: Vec3,
+    /// Cosine of its half-angle.
+    pub cos_angle: f32,
+}
+
+impl Cone {
+    /// Every direction.
+    pub const ALL: Cone = Cone {
+        axis: Vec3::Z,
+        cos_angle: -1.0,
+    };
+
+    /// The smallest cone (by this construction) holding both (pbrt-v4 §3.8.4).
+    fn union(self, other: Cone) -> Cone {
+        let (a, b) = (self, other);
+        let theta_a = a.cos_angle.clamp(-1.0, 1.0).acos();
+        let theta_b = b.cos_angle.clamp(-1.0, 1.0).acos();
+        let theta_d = angle_between(a.axis, b.axis);
+        let pi = std::f32::consts::PI;
+        if (theta_d + theta_b).min(pi) <= theta_a {
+            return a;
+        }
+        if (theta_d + theta_a).min(pi) <= theta_b {
+            return b;
+        }
+        let theta_o = 0.5 * (theta_a + theta_d + theta_b);
+        if theta_o >= pi {
+            return Cone::ALL;
+        }
+        let rotate_by = theta_o - theta_a;
+        let about = a.axis.cross(b.axis);
+        if about.length_squared() < 1e-12 {
+            return Cone::ALL;
+        }
+        Cone {
+            axis: (Quat::from_axis_angle(about.normalize(), rotate_by) * a.axis).normalize(),
+            cos_angle: theta_o.cos(),
+        }
+    }
+}
+
+/// What a light (or a node's lights) can send where.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightBounds {
+    /// Where its emitting points are.
+    pub bounds: Aabb,
+    /// Its power (W).
+    pub power: f32,
+    /// The directions its surface normals (or a spot's axis) point in.
+    pub normals: Cone,
+    /// Cosine of the angle beyond the normal cone within which it still emits: 0 for
+    /// surfaces (a hemisphere), 1 for a hard-edged spot (nothing outside its cone).
+    pub cos_emission: f32,
+    /// Emits on both sides of its normals.
+    pub two_sided: bool,
+}
+
+impl LightBounds {
+    fn union(&self, other: &LightBounds) -> LightBounds {
+        if self.power == 0.0 {
+            return *other;
+        }
+        if other.power == 0.0 {
+            return *self;
+        }
+        LightBounds {
+            bounds: self.bounds.union(other.bounds),
+            power: self.power + other.power,
+            normals: self.normals.union(other.normals),
+            cos_emission: self.cos_emission.min(other.cos_emission),
+            two_sided: self.two_sided || other.two_sided,
+        }
+    }
+
+    /// An upper bound on what the lights inside can bring to a receiver at `p` with normal
+    /// `n` (zero `n`: no receiver cosine), up to a common factor (pbrt-v4 §12.6.3).
+    pub fn importance(&self, p: Vec3, n: Vec3) -> f32 {
+        let centre = 0.5 * (self.bounds.min + self.bounds.max);
+        let diagonal = (self.bounds.max - self.bounds.min).length();
+        let d2 = p.distance_squared(centre).max(0.5 * diagonal);
+        if d2 == 0.0 || !d2.is_finite() {
+            return 0.0;
+        }
+        let wi = (p - centre) / d2.sqrt();
+        let mut cos_w = self.normals.axis.dot(wi);
+        if self.two_sided {
+            cos_w = cos_w.abs();
+        }
+        let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
+        // The directions from the box to p lie within θb of wi.
+        let (sin_b, cos_b) = subtended(&self.bounds, p);
+        let cos_o = self.normals.cos_angle;
+        let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
+        // θ' = max(0, θw − θo − θb): the smallest angle between an emitting direction and a
+        // direction towards p.
+        let (sin_x, cos_x) = minus_clamped(sin_w, cos_w, sin_o, cos_o);
+        let (_, cos_p) = minus_clamped(sin_x, cos_x, sin_b, cos_b);
+        if cos_p < self.cos_emission {
+            return 0.0;
+        }
+        let mut importance = self.power * cos_p.max(0.0) / d2;
+        if n != Vec3::ZERO {
+            let cos_i = wi.dot(n).abs();
+            let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
+            importance *= minus_clamped(sin_i, cos_i, sin_b, cos_b).1.max(0.0);
+        }
+        importance.max(0.0)
+    }
+}
+
+/// (sin, cos) of max(0, θa − θb) from the sines and cosines of θa and θb.
+fn minus_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> (f32, f32) {
+    if cos_a > cos_b {
+        (0.0, 1.0)
+    } else {
+        (
+            sin_a * cos_b - cos_a * sin_b,
+            cos_a * cos_b + sin_a * sin_b,
+        )
+    }
+}
+
+/// (sin, cos) of the half-angle of the cone from `p` that holds the box's bounding sphere
+/// (every direction when `p` is inside it).
+fn subtended(bounds: &Aabb, p: Vec3) -> (f32, f32) {
+    let centre = 0.5 * (bounds.min + bounds.max);
+    let r2 = (0.25 * (bounds.max - bounds.min).length_squared()).max(0.0);
+    let d2 = p.distance_squared(centre);
+    if d2 <= r2 {
+        return (0.0, -1.0);
+    }
+    let sin2 = r2 / d2;
+    (sin2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
+}
+
+fn angle_between(a: Vec3, b: Vec3) -> f32 {
+    // Stable for nearly parallel and nearly opposite vectors.
+    if a.dot(b) < 0.0 {
+        std::f32::consts::PI - 2.0 * ((a + b).length() / 2.0).clamp(-1.0, 1.0).asin()
+    } else {
+        2.0 * ((b - a).length() / 2.0).clamp(-1.0, 1.0).asin()
+    }
+}
+
+#[derive(Clone, Debug)]
+struct Node {
+    bounds: LightBounds,
+    /// A leaf's light, or the index of an inner node's second child (the first follows it).
+    light_or_second: u32,
+    leaf: bool,
+}
+
+/// The tree over the lights with a place, and the lights at infinity beside it.
+#[derive(Clone, Debug, Default)]
+pub struct LightTree {
+    nodes: Vec<Node>,
+    /// For each light: its path from the root (bit i: second child at depth i) and depth,
+    /// or `None` for a light at infinity or without power.
+    paths: Vec<Option<(u64, u8)>>,
+    /// The lights at infinity and the irradiance each brings.
+    infinite: Vec<(usize, f32)>,
+    /// Where each light at infinity is in `infinite`.
+    infinite_slot: Vec<Option<usize>>,
+}
+
+/// A light for the tree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TreeInput {
+    /// A light with a place, and what it can send where.
+    Placed(LightBounds),
+    /// A light at infinity, and the irradiance it brings to a surface facing it (W/m²).
+    Infinite(f32),
+}
+
+impl LightTree {
+    /// Builds the tree over `lights` (indexed as the caller indexes its lights); lights
+    /// without power are never chosen.
+    pub fn build(lights: &[TreeInput]) -> LightTree {
+        let mut tree = LightTree {
+            nodes: Vec::new(),
+            paths: vec![None; lights.len()],
+            infinite: Vec::new(),
+            infinite_slot: vec![None; lights.len()],
+        };
+        let mut placed = Vec::new();
+        for (i, light) in lights.iter().enumerate() {
+            match *light {
+                TreeInput::Infinite(e) if e > 0.0 && e.is_finite() => {
+                    tree.infinite_slot[i] = Some(tree.infinite.len());
+                    tree.infinite.push((i, e));
+                }
+                TreeInput::Placed(b) if b.power > 0.0 && b.power.is_finite() => {
+                    placed.push((i, b))
+                }
+                _ => {}
+            }
+        }
+        if !placed.is_empty() {
+            tree.build_node(&mut placed, 0, 0);
+        }
+        tree
+    }
+
+    /// Adds the node over `lights`, reached by `path` at `depth`; returns its index.
+    fn build_node(&mut self, lights: &mut [(usize, LightBounds)], path: u64, depth: u8) -> usize {
+        let index = self.nodes.len();
+        if lights.len() == 1 || depth == 63 {
+            // Depth 63 is unreachable with median splits below 2^63 lights.
+            let (light, bounds) = lights[0];
+            self.nodes.push(Node {
+                bounds,
+                light_or_second: light as u32,
+                leaf: true,
+            });
+            self.paths[light] = Some((path, depth));
+            return index;
+        }
+        let bounds = lights[1..]
+            .iter()
+            .fold(lights[0].1, |b, (_, l)| b.union(l));
+        self.nodes.push(Node {
+            bounds,
+            light_or_second: 0,
+            leaf: false,
+        });
+        // Median split of the centroids along their widest axis: a balanced tree, so paths
+        // stay short however many lights there are.
+        let centroid = |b: &LightBounds| 0.5 * (b.bounds.min + b.bounds.max);
+        let spread = lights.iter().fold(Aabb::EMPTY, |a, (_, l)| {
+            a.union(Aabb {
+                min: centroid(l),
+                max: centroid(l),
+            })
+        });
+        let axis = (spread.max - spread.min).max_position();
+        let middle = lights.len() / 2;
+        lights.select_nth_unstable_by(middle, |a, b| {
+            centroid(&a.1)[axis].total_cmp(&centroid(&b.1)[axis])
+        });
+        let (first, second) = lights.split_at_mut(middle);
+        self.build_node(first, path, depth + 1);
+        let second_index = self.build_node(second, path | (1 << depth), depth + 1);
+        self.nodes[index].light_or_second = second_index as u32;
+        index
+    }
+
+    /// The weight of the tree (its root's importance as an irradiance) at a receiver, and
+    /// the total with the lights at infinity.
+    fn tree_weight(&self, p: Vec3, n: Vec3) -> (f32, f32) {
+        let tree = self.nodes.first().map_or(0.0, |root| {
+            root.bounds.importance(p, n) / std::f32::consts::TAU
+        });
+        let total = tree + self.infinite.iter().map(|&(_, e)| e).sum::<f32>();
+        (tree, total)
+    }
+
+    /// A light for a receiver at `p` with normal `n`, and the probability it was chosen
+    /// with; `u` in [0, 1).
+    pub fn choose(&self, p: Vec3, n: Vec3, u: f32) -> Option<(usize, f32)> {
+        let (tree, total) = self.tree_weight(p, n);
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        // The lights at infinity first, then the tree.
+        let mut start = 0.0;
+        for &(light, e) in &self.infinite {
+            let pmf = e / total;
+            if u < start + pmf || tree == 0.0 && start + pmf >= 1.0 - 1e-6 {
+                return Some((light, pmf));
+            }
+            start += pmf;
+        }
+        if tree == 0.0 {
+            return None;
+        }
+        let share = tree / total;
+        let mut u = ((u - start) / share).clamp(0.0, 1.0 - f32::EPSILON);
+        let mut pmf = share;
+        let mut node = 0;
+        loop {
+            let here = &self.nodes[node];
+            if here.leaf {
+                return Some((here.light_or_second as usize, pmf));
+            }
+            let (first, second) = (node + 1, here.light_or_second as usize);
+            let a = self.nodes[first].bounds.importance(p, n);
+            let b = self.nodes[second].bounds.importance(p, n);
+            if a + b == 0.0 || !(a + b).is_finite() {
+                return None;
+            }
+            let p_first = a / (a + b);
+            if u < p_first {
+                u = (u / p_first).min(1.0 - f32::EPSILON);
+                pmf *= p_first;
+                node = first;
+            } else {
+                u = ((u - p_first) / (1.0 - p_first)).min(1.0 - f32::EPSILON);
+                pmf *= 1.0 - p_first;
+                node = second;
+            }
+        }
+    }
+
+    /// The probability that [`LightTree::choose`] picks `light` for a receiver at `p` with
+    /// normal `n`.
+    pub fn pmf(&self, light: usize, p: Vec3, n: Vec3) -> f32 {
+        let (tree, total) = self.tree_weight(p, n);
+        if !(total > 0.0 && total.is_finite()) {
+            return 0.0;
+        }
+        if let Some(slot) = self.infinite_slot[light] {
+            return self.infinite[slot].1 / total;
+        }
+        let Some((path, depth)) = self.paths[light] else {
+            return 0.0;
+        };
+        let mut pmf = tree / total;
+        let mut node = 0;
+        for level in 0..depth {
+            let here = &self.nodes[node];
+            let (first, second) = (node + 1, here.light_or_second as usize);
+            let a = self.nodes[first].bounds.importance(p, n);
+            let b = self.nodes[second].bounds.importance(p, n);
+            if a + b == 0.0 || !(a + b).is_finite() {
+                return 0.0;
+            }
+            if path & (1 << level) == 0 {
+                pmf *= a / (a + b);
+                node = first;
+            } else {
+                pmf *= b / (a + b);
+                node = second;
+            }
+        }
+        pmf
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::sampling::Rng;
+
+    fn point_light(p: Vec3, power: f32) -> TreeInput {
+        TreeInput::Placed(LightBounds {
+            bounds: Aabb { min: p, max: p },
+            power,
+            normals: Cone::ALL,
+            cos_emission: 0.0,
+            two_sided: false,
+        })
+    }
+
+    #[test]
+    fn choices_happen_as_often_as_their_probability_says() {
+        let mut lights: Vec<TreeInput> = (0..40)
+            .map(|i| {
+                let x = i as f32 * 0.37;
+                point_light(Vec3::new(x.sin() * 5.0, x.cos() * 3.0, i as f32 * 0.1), 1.0 + (i % 7) as f32)
+            })
+            .collect();
+        lights.push(TreeInput::Infinite(0.05));
+        lights.push(TreeInput::Placed(LightBounds {
+            bounds: Aabb {
+                min: Vec3::new(-1.0, 2.0, -1.0),
+                max: Vec3::new(1.0, 2.0, 1.0),
+            },
+            power: 10.0,
+            normals: Cone {
+                axis: -Vec3::Y,
+                cos_angle: 1.0,
+            },
+            cos_emission: 0.0,
+            two_sided: false,
+        }));
+        let tree = LightTree::build(&lights);
+        let (p, n) = (Vec3::new(0.3, 0.1, 0.2), Vec3::Y);
+        let total: f32 = (0..lights.len()).map(|i| tree.pmf(i, p, n)).sum();
+        assert!((total - 1.0).abs() < 1e-4, "probabilities sum to {total}");
+        let samples = 200_000;
+        let mut counts = vec![0u64; lights.len()];
+        let mut rng = Rng::new(1, 2);
+        for _ in 0..samples {
+            let (light, pmf) = tree.choose(p, n, rng.uniform()).unwrap();
+            assert!((pmf - tree.pmf(light, p, n)).abs() <= 1e-4 * pmf);
+            counts[light] += 1;
+        }
+        for (i, &c) in counts.iter().enumerate() {
+            let expected = tree.pmf(i, p, n) as f64 * samples as f64;
+            let sigma = expected.sqrt().max(1.0);
+            assert!((c as f64 - expected).abs() < 5.0 * sigma, "light {i}: {c} vs {expected:.0}");
+        }
+        // Well behind the one-sided panel (above it, it faces down) nothing of it can
+        // arrive; close by, its bounds cannot tell.
+        assert_eq!(tree.pmf(lights.len() - 1, Vec3::new(0.0, 10.0, 0.0), Vec3::Y), 0.0);
+        assert!(tree.pmf(lights.len() - 1, Vec3::new(0.0, 0.0, 0.0), Vec3::Y) > 0.0);
+    }
+
+    #[test]
+    fn a_spot_is_never_chosen_outside_its_cone() {
+        let spot = TreeInput::Placed(LightBounds {
+            bounds: Aabb {
+                min: Vec3::Y,
+                max: Vec3::Y,
+            },
+            power: 100.0,
+            normals: Cone {
+                axis: -Vec3::Y,
+                cos_angle: 30f32.to_radians().cos(),
+            },
+            cos_emission: 1.0,
+            two_sided: false,
+        });
+        let tree = LightTree::build(&[spot, point_light(Vec3::new(5.0, 1.0, 0.0), 1.0)]);
+        assert!(tree.pmf(0, Vec3::new(0.3, 0.0, 0.0), Vec3::Y) > 0.9);
+        assert_eq!(tree.pmf(0, Vec3::new(2.0, 0.0, 0.0), Vec3::Y), 0.0);
+    }
+}
