@@ -336,7 +336,10 @@ mod tests {
             .filter(|l| !l.starts_with("exposure="))
             .map(|l| format!("{l}\n"))
             .collect();
-        assert_eq!(RenderRecord::from_text(&old).unwrap().identity.exposure, 0.0);
+        assert_eq!(
+            RenderRecord::from_text(&old).unwrap().identity.exposure,
+            0.0
+        );
     }
 
     #[test]

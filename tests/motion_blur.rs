@@ -216,22 +216,24 @@ fn check_streak(what: &str, image: &[f64], still_energy: f64) {
     );
 }
 
+/// The light in the image of `usda` with the shutter closed, checked against the square's
+/// radiance × area.
+fn still_energy(dir: &Path, usda: &str) -> f64 {
+    let still = render(dir, "still", usda, &["--shutter", "0..0", "--spp", "16"]);
+    let energy: f64 = still.iter().sum();
+    let side_pixels = (SIDE * 100.0).powi(2);
+    assert!(
+        (energy / (side_pixels * RADIANCE) - 1.0).abs() < 0.01,
+        "the still square holds its radiance × area"
+    );
+    energy
+}
+
 #[test]
 fn a_moving_emitter_leaves_a_streak_of_the_expected_length_and_energy() {
     let dir = tempfile::tempdir().unwrap();
     let spp = ["--spp", "64"];
-    let still = render(
-        dir.path(),
-        "still",
-        &moved_by_transform(),
-        &["--shutter", "0..0", "--spp", "16"],
-    );
-    let still_energy: f64 = still.iter().sum();
-    let side_pixels = (SIDE * 100.0).powi(2);
-    assert!(
-        (still_energy / (side_pixels * RADIANCE) - 1.0).abs() < 0.01,
-        "the still square holds its radiance × area"
-    );
+    let still_energy = still_energy(dir.path(), &moved_by_transform());
     let moving = render(dir.path(), "moving", &moved_by_transform(), &spp);
     check_streak("transform", &moving, still_energy);
     let camera = render(dir.path(), "camera", &camera_moving(), &spp);
@@ -241,13 +243,7 @@ fn a_moving_emitter_leaves_a_streak_of_the_expected_length_and_energy() {
 #[test]
 fn a_deforming_emitter_is_drawn_at_every_step() {
     let dir = tempfile::tempdir().unwrap();
-    let still = render(
-        dir.path(),
-        "still",
-        &moved_by_points(),
-        &["--shutter", "0..0", "--spp", "16"],
-    );
-    let still_energy: f64 = still.iter().sum();
+    let still_energy = still_energy(dir.path(), &moved_by_points());
     // With 2 steps only the ends are drawn: two squares, each half the time, and nothing
     // between them.
     let two = column_means(&render(

@@ -36,14 +36,16 @@ fn coloured_and_small_lights_match_cycles() {
     check_scene("coloured_lights", 512);
 }
 
-/// The error against the reference falls like 1/√spp: an unbiased renderer's mean squared
-/// error is its variance, σ²/spp, once the reference's own noise is taken off. A bias would
-/// flatten the curve at its square.
+/// The error against the reference falls at least like 1/√spp: an unbiased renderer's mean
+/// squared error is its variance, σ²/spp or less (stratified samples converge faster on the
+/// smooth parts of the integrand), once the reference's own noise is taken off. A bias
+/// would flatten the curve at its square: the last step, 64 → 256 spp, must still fall at
+/// least as 1/√spp does, less the slope's noise.
 ///
 /// One 128² image's MSE is itself noisy (±25 % at 8 spp, where rare bright paths are mostly
 /// missed), so each level averages renders of the same total work: 64 × 4 spp, 16 × 16 spp,
-/// 4 × 64 spp, 1 × 256 spp. That leaves about ±8 % on each MSE, ±0.013 on the fitted slope;
-/// the test allows ±0.05.
+/// 4 × 64 spp, 1 × 256 spp. That leaves about ±8 % on each MSE, ±0.013 on the fitted slope
+/// and ±0.04 on the last step's; measured: −0.72 overall, −0.61 for the last step.
 #[test]
 fn error_falls_as_one_over_root_spp() {
     let name = "cornell_box";
@@ -85,10 +87,12 @@ fn error_falls_as_one_over_root_spp() {
     );
     let slope = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
         / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
-    println!("log-log slope {slope:.3}");
+    let last = (points[3].1 - points[2].1) / (points[3].0 - points[2].0);
+    println!("log-log slope {slope:.3}, last step {last:.3}");
     assert!(
-        (slope + 0.5).abs() < 0.05,
-        "RMSE against the reference falls with slope {slope:.3}, not −0.5: {points:?}"
+        slope < -0.45 && last < -0.45,
+        "RMSE against the reference falls with slope {slope:.3} (last step {last:.3}), \
+         slower than 1/√spp: {points:?}"
     );
 }
 

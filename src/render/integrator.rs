@@ -105,7 +105,9 @@ impl Renderer<'_> {
             let Some(hit) = hit else {
                 // The path leaves the scene: the environment, weighed like any emitter,
                 // unless it is hidden from camera rays.
-                let (environment, light_pdf) = self.lights.environment(vertex, vertex_normal, ray.direction);
+                let (environment, light_pdf) =
+                    self.lights
+                        .environment(vertex, vertex_normal, ray.direction);
                 if depth == 0 && !self.environment_visible {
                     break;
                 }
@@ -152,17 +154,15 @@ impl Renderer<'_> {
 
             // Emission reached by the previous bounce.
             if material.is_emissive() && (front || material.double_sided) {
-                let light_pdf =
-                    self.lights
-                        .pdf(
-                        hit.instance,
-                        hit.triangle,
-                        hit.time,
-                        vertex,
-                        vertex_normal,
-                        travelled,
-                        cos_o,
-                    );
+                let light_pdf = self.lights.pdf(
+                    hit.instance,
+                    hit.triangle,
+                    hit.time,
+                    vertex,
+                    vertex_normal,
+                    travelled,
+                    cos_o,
+                );
                 let weight = emission_weight(arrival, strategy, light_pdf);
                 result.radiance += weight * beta * shading.emission;
             }
@@ -192,7 +192,8 @@ impl Renderer<'_> {
                 && (strategy != Strategy::BsdfOnly || self.lights.punctual_len() > 0)
             {
                 result.rays += 1;
-                result.radiance += beta * self.direct_light(&bsdf, &s, ng, ns, wo, sampler, strategy);
+                result.radiance +=
+                    beta * self.direct_light(&bsdf, &s, ng, ns, wo, sampler, strategy);
             }
 
             // Sample the BSDF to extend the path.
@@ -265,7 +266,8 @@ impl Renderer<'_> {
         let sample = if strategy == Strategy::BsdfOnly {
             self.lights.sample_punctual(s.point, u_light)
         } else {
-            self.lights.sample(self.scene, s.point, ns, s.time, u_light, u)
+            self.lights
+                .sample(self.scene, s.point, ns, s.time, u_light, u)
         };
         let Some(ls) = sample else {
             return Vec3::ZERO;

@@ -205,8 +205,12 @@ impl<'a> Renderer<'a> {
                         let time = if timed { sampler.uniform() } else { 0.0 };
                         let (px, py) = (x as f32 + at.x, y as f32 + at.y);
                         let ray = generator.generate_through_lens(px, py, lens, time);
-                        let path =
-                            self.trace_path(ray, &mut sampler, settings.max_depth, settings.strategy);
+                        let path = self.trace_path(
+                            ray,
+                            &mut sampler,
+                            settings.max_depth,
+                            settings.strategy,
+                        );
                         rays += path.rays;
                         acc.add(path.radiance, path.hit);
                     }

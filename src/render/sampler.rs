@@ -106,9 +106,15 @@ fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
     v.reverse_bits()
 }
 
-/// Burley's hash_combine (after Boost): a seed for a sub-stream.
+/// Burley's hash_combine (after Boost): a seed for a sub-stream, from a 32-bit integer
+/// hash of `v` (Wellons' "lowbias32", a bijection with low bias).
 fn hash_combine(seed: u32, v: u32) -> u32 {
-    let h = mix64(u64::from(v)) as u32;
+    let mut h = v;
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7feb_352d);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846c_a68b);
+    h ^= h >> 16;
     seed ^ (h
         .wrapping_add(0x9e37_79b9)
         .wrapping_add(seed << 6)
@@ -150,7 +156,10 @@ mod tests {
                             s.uniform2()
                         })
                         .collect();
-                    assert!(is_net(&points, k), "pixel {pixel}, samples {start}+2^{k}, set {set}");
+                    assert!(
+                        is_net(&points, k),
+                        "pixel {pixel}, samples {start}+2^{k}, set {set}"
+                    );
                 }
             }
         }

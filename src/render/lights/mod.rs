@@ -264,9 +264,7 @@ impl LightSet {
             Light::Triangle(i) => {
                 let t = &self.triangles[i];
                 let corners = |p: &PlacedTriangle| {
-                    p.corners
-                        .iter()
-                        .fold(Aabb::EMPTY, |b, c| b.union(at(c.0)))
+                    p.corners.iter().fold(Aabb::EMPTY, |b, c| b.union(at(c.0)))
                 };
                 match t.moving {
                     None => surface(
@@ -605,6 +603,7 @@ impl LightSet {
     /// point of triangle `triangle` of instance `instance` at `distance` and light cosine
     /// `cos_light`.
     /// `time` is the shutter time of the ray that hit it.
+    #[allow(clippy::too_many_arguments)]
     pub fn pdf(
         &self,
         instance: u32,

@@ -23,7 +23,11 @@ pub fn solid_angle(p: Vec3, corners: [Vec3; 3]) -> f64 {
     let denominator = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
     let half = numerator.atan2(denominator);
     let omega = 2.0 * half;
-    if omega.is_finite() { omega.max(0.0) } else { 0.0 }
+    if omega.is_finite() {
+        omega.max(0.0)
+    } else {
+        0.0
+    }
 }
 
 /// True when the triangle is sampled by solid angle from there.
@@ -48,7 +52,7 @@ pub fn sample(p: Vec3, corners: [Vec3; 3], u: Vec2) -> Option<(Vec3, Vec2)> {
     let beta = angle(n_bc, -n_ab);
     let gamma = angle(n_ca, -n_bc);
     let area = alpha + beta + gamma - std::f64::consts::PI;
-    if !(area > 0.0) {
+    if area.is_nan() || area <= 0.0 {
         return None;
     }
     // The sub-triangle (a, b, c') of area u₀·A fixes c' on the great arc from a to c …
@@ -139,7 +143,10 @@ mod tests {
         for i in 0..n {
             for j in 0..n - i {
                 cell_of.insert((i, j, false), expected.len());
-                expected.push(solid_angle(p, [point(i, j), point(i + 1, j), point(i, j + 1)]));
+                expected.push(solid_angle(
+                    p,
+                    [point(i, j), point(i + 1, j), point(i, j + 1)],
+                ));
                 if i + j + 1 < n {
                     cell_of.insert((i, j, true), expected.len());
                     expected.push(solid_angle(
@@ -157,12 +164,17 @@ mod tests {
         for _ in 0..samples {
             let (w, b) = sample(p, corners, rng.uniform2()).unwrap();
             // The direction meets the triangle at the barycentrics returned.
-            let hit = corners[0] + b.x * (corners[1] - corners[0]) + b.y * (corners[2] - corners[0]);
+            let hit =
+                corners[0] + b.x * (corners[1] - corners[0]) + b.y * (corners[2] - corners[0]);
             assert!(((hit - p).normalize() - w).length() < 1e-4);
             let (s, t) = (b.x * n as f32, b.y * n as f32);
             let (i, j) = ((s as usize).min(n - 1), (t as usize).min(n - 1));
             let upper = s.fract() + t.fract() > 1.0 && i + j + 1 < n;
-            let key = if i + j >= n { (i.min(n - 1 - j), j, false) } else { (i, j, upper) };
+            let key = if i + j >= n {
+                (i.min(n - 1 - j), j, false)
+            } else {
+                (i, j, upper)
+            };
             counts[cell_of[&key]] += 1;
         }
         let chi: f64 = counts

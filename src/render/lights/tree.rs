@@ -139,10 +139,7 @@ fn minus_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> (f32, f32) {
     if cos_a > cos_b {
         (0.0, 1.0)
     } else {
-        (
-            sin_a * cos_b - cos_a * sin_b,
-            cos_a * cos_b + sin_a * sin_b,
-        )
+        (sin_a * cos_b - cos_a * sin_b, cos_a * cos_b + sin_a * sin_b)
     }
 }
 
@@ -215,9 +212,7 @@ impl LightTree {
                     tree.infinite_slot[i] = Some(tree.infinite.len());
                     tree.infinite.push((i, e));
                 }
-                TreeInput::Placed(b) if b.power > 0.0 && b.power.is_finite() => {
-                    placed.push((i, b))
-                }
+                TreeInput::Placed(b) if b.power > 0.0 && b.power.is_finite() => placed.push((i, b)),
                 _ => {}
             }
         }
@@ -241,9 +236,7 @@ impl LightTree {
             self.paths[light] = Some((path, depth));
             return index;
         }
-        let bounds = lights[1..]
-            .iter()
-            .fold(lights[0].1, |b, (_, l)| b.union(l));
+        let bounds = lights[1..].iter().fold(lights[0].1, |b, (_, l)| b.union(l));
         self.nodes.push(Node {
             bounds,
             light_or_second: 0,
@@ -382,7 +375,10 @@ mod tests {
         let mut lights: Vec<TreeInput> = (0..40)
             .map(|i| {
                 let x = i as f32 * 0.37;
-                point_light(Vec3::new(x.sin() * 5.0, x.cos() * 3.0, i as f32 * 0.1), 1.0 + (i % 7) as f32)
+                point_light(
+                    Vec3::new(x.sin() * 5.0, x.cos() * 3.0, i as f32 * 0.1),
+                    1.0 + (i % 7) as f32,
+                )
             })
             .collect();
         lights.push(TreeInput::Infinite(0.05));
@@ -414,11 +410,17 @@ mod tests {
         for (i, &c) in counts.iter().enumerate() {
             let expected = tree.pmf(i, p, n) as f64 * samples as f64;
             let sigma = expected.sqrt().max(1.0);
-            assert!((c as f64 - expected).abs() < 5.0 * sigma, "light {i}: {c} vs {expected:.0}");
+            assert!(
+                (c as f64 - expected).abs() < 5.0 * sigma,
+                "light {i}: {c} vs {expected:.0}"
+            );
         }
         // Well behind the one-sided panel (above it, it faces down) nothing of it can
         // arrive; close by, its bounds cannot tell.
-        assert_eq!(tree.pmf(lights.len() - 1, Vec3::new(0.0, 10.0, 0.0), Vec3::Y), 0.0);
+        assert_eq!(
+            tree.pmf(lights.len() - 1, Vec3::new(0.0, 10.0, 0.0), Vec3::Y),
+            0.0
+        );
         assert!(tree.pmf(lights.len() - 1, Vec3::new(0.0, 0.0, 0.0), Vec3::Y) > 0.0);
     }
 
