@@ -48,10 +48,7 @@ impl Sampler {
     pub fn uniform(&mut self) -> f32 {
         let seed = self.next_set_seed();
         let index = nested_uniform_scramble(self.index, seed);
-        to_unit(nested_uniform_scramble(
-            index.reverse_bits(),
-            hash_combine(seed, 1),
-        ))
+        to_unit(scrambled_first(index, seed))
     }
 
     /// Two numbers in [0, 1)², jointly stratified over the pixel's samples.
@@ -59,10 +56,7 @@ impl Sampler {
         let seed = self.next_set_seed();
         let index = nested_uniform_scramble(self.index, seed);
         Vec2::new(
-            to_unit(nested_uniform_scramble(
-                index.reverse_bits(),
-                hash_combine(seed, 1),
-            )),
+            to_unit(scrambled_first(index, seed)),
             to_unit(nested_uniform_scramble(
                 sobol_second(index),
                 hash_combine(seed, 2),
@@ -75,6 +69,13 @@ impl Sampler {
         self.set += 1;
         seed
     }
+}
+
+/// The first Sobol dimension (the bits of `index` reversed), Owen-scrambled. Scrambling
+/// reverses its input's bits, so the two reversals cancel:
+/// `nested_uniform_scramble(index.reverse_bits(), s)` = `laine_karras(index, s).reverse_bits()`.
+fn scrambled_first(index: u32, seed: u32) -> u32 {
+    laine_karras(index, hash_combine(seed, 1)).reverse_bits()
 }
 
 /// The second Sobol dimension at `index`: generator matrix from the primitive polynomial
@@ -97,13 +98,18 @@ fn sobol_second(index: u32) -> u32 {
 /// hash of the bits above it (Burley 2020, §3: the Laine–Karras permutation on reversed
 /// bits, with Burley's improved constants).
 fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
-    let mut v = x.reverse_bits();
-    v = v.wrapping_add(seed);
+    laine_karras(x.reverse_bits(), seed).reverse_bits()
+}
+
+/// The Laine–Karras permutation with Burley's constants: each bit of `v` flipped by a hash
+/// of the bits below it.
+fn laine_karras(v: u32, seed: u32) -> u32 {
+    let mut v = v.wrapping_add(seed);
     v ^= v.wrapping_mul(0x6c50_b47c);
     v ^= v.wrapping_mul(0xb82f_1e52);
     v ^= v.wrapping_mul(0xc7af_e638);
     v ^= v.wrapping_mul(0x8d22_f6e6);
-    v.reverse_bits()
+    v
 }
 
 /// Burley's hash_combine (after Boost): a seed for a sub-stream, from a 32-bit integer
@@ -211,6 +217,16 @@ mod tests {
         for counts in [&marginal, &joint] {
             let (chi, limit) = chi_square_ok(counts);
             assert!(chi < limit, "χ² {chi:.1} over the 99.99 % point {limit:.1}");
+        }
+    }
+
+    #[test]
+    fn the_shortcut_for_the_first_dimension_is_the_full_scramble() {
+        for (index, seed) in [(0u32, 1u32), (5, 77), (1 << 20, 0xdead_beef), (u32::MAX, 3)] {
+            assert_eq!(
+                scrambled_first(index, seed),
+                nested_uniform_scramble(index.reverse_bits(), hash_combine(seed, 1))
+            );
         }
     }
 

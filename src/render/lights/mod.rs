@@ -405,7 +405,7 @@ impl LightSet {
         let omega = spherical::solid_angle(p, corners);
         let by_solid_angle = spherical::use_solid_angle(omega);
         let b = if by_solid_angle {
-            spherical::sample(p, corners, u)?.1
+            spherical::sample(p, corners, omega, u)?.1
         } else {
             uniform_triangle(u)
         };

@@ -35,26 +35,19 @@ pub fn use_solid_angle(omega: f64) -> bool {
     (MIN_SOLID_ANGLE..=MAX_SOLID_ANGLE).contains(&omega)
 }
 
-/// A direction from `p` uniform over the solid angle of triangle `corners`, and the
-/// barycentrics (b1, b2) of the point where it meets the triangle; `None` when the
-/// triangle is degenerate as seen from `p`.
-pub fn sample(p: Vec3, corners: [Vec3; 3], u: Vec2) -> Option<(Vec3, Vec2)> {
+/// A direction from `p` uniform over the solid angle of triangle `corners`, whose solid
+/// angle [`solid_angle`] gave as `area`, and the barycentrics (b1, b2) of the point where it
+/// meets the triangle; `None` when the triangle is degenerate as seen from `p`.
+pub fn sample(p: Vec3, corners: [Vec3; 3], area: f64, u: Vec2) -> Option<(Vec3, Vec2)> {
     let [a, b, c] = corners.map(|v| (v - p).as_dvec3().normalize_or_zero());
     let n_ab = a.cross(b).normalize_or_zero();
-    let n_bc = b.cross(c).normalize_or_zero();
     let n_ca = c.cross(a).normalize_or_zero();
-    if n_ab == DVec3::ZERO || n_bc == DVec3::ZERO || n_ca == DVec3::ZERO {
+    if n_ab == DVec3::ZERO || n_ca == DVec3::ZERO || area.is_nan() || area <= 0.0 {
         return None;
     }
-    // The spherical triangle's interior angles at a, b and c.
-    let angle = |x: DVec3, y: DVec3| x.dot(y).clamp(-1.0, 1.0).acos();
-    let alpha = angle(n_ab, -n_ca);
-    let beta = angle(n_bc, -n_ab);
-    let gamma = angle(n_ca, -n_bc);
-    let area = alpha + beta + gamma - std::f64::consts::PI;
-    if area.is_nan() || area <= 0.0 {
-        return None;
-    }
+    // The spherical triangle's interior angle at a (its area, the sum of the three angles
+    // less π, is the solid angle already known).
+    let alpha = n_ab.dot(-n_ca).clamp(-1.0, 1.0).acos();
     // The sub-triangle (a, b, c') of area u₀·A fixes c' on the great arc from a to c …
     let sub_area = f64::from(u.x) * area;
     let (sin_phi, cos_phi) = (sub_area + std::f64::consts::PI - alpha).sin_cos();
@@ -162,7 +155,7 @@ mod tests {
         let mut counts = vec![0u64; expected.len()];
         let mut rng = Rng::new(5, 8);
         for _ in 0..samples {
-            let (w, b) = sample(p, corners, rng.uniform2()).unwrap();
+            let (w, b) = sample(p, corners, total, rng.uniform2()).unwrap();
             // The direction meets the triangle at the barycentrics returned.
             let hit =
                 corners[0] + b.x * (corners[1] - corners[0]) + b.y * (corners[2] - corners[0]);
