@@ -1,7 +1,7 @@
 //! The lights next-event estimation samples — every triangle of an emissive material in
-//! world space, every punctual light, the environment — each chosen in proportion to its
-//! emitted power ([`Light`] names one of them; each kind has its power and density here or
-//! beside its data, and nowhere else).
+//! world space, every punctual light, the environment — chosen for each shading point by
+//! the light tree ([`tree`]) from their power and bounds ([`Light`] names one of them; each
+//! kind has its power, bounds and density here or beside its data, and nowhere else).
 
 mod environment;
 mod sphere;
