@@ -36,6 +36,10 @@ pub const MAX_MEAN_ERROR: f64 = 0.02;
 /// sampler's renders show too (measured: principled_plastics, PCG at 2048 spp, +2.3 ‰ over
 /// the left block column; Cycles' Principled BSDF interpolates precomputed albedo tables).
 /// 0.3 % keeps the test about as strict as it was while staying far below a real error.
+/// In blocks darker than the image's mean it is taken of the mean: there the light comes
+/// from rare paths (lighting_lamps' block (9, 7) reads 0.00024 against 0.00046 at 1024
+/// spp; eight seeds at 512 spp give 0.00038 ± 0.00009, one of them 0.00104), and two
+/// halves that both miss them under-state their noise.
 pub const MODEL_TOLERANCE: f64 = 0.003;
 
 /// Two independent halves of one render, per pixel.
@@ -174,7 +178,8 @@ pub struct Comparison {
 }
 
 pub fn compare(gridtrace: &Halves, reference: &Halves) -> Comparison {
-    let mean_ratio = gridtrace.image_mean() / reference.image_mean();
+    let reference_mean = reference.image_mean();
+    let mean_ratio = gridtrace.image_mean() / reference_mean;
     let (mut max_z, mut sum_z2, mut n) = (0.0f64, 0.0f64, 0usize);
     let mut worst_block = (0, 0, 0);
     let (mut error, mut noise, mut counted) = (0.0f64, 0.0f64, 0usize);
@@ -188,7 +193,7 @@ pub fn compare(gridtrace: &Halves, reference: &Halves) -> Comparison {
         for c in 0..3 {
             // The standard error of the difference, with the models' tolerance (which also
             // covers a block without noise on either side, an environment seen directly).
-            let model = MODEL_TOLERANCE * r[c].abs();
+            let model = MODEL_TOLERANCE * r[c].abs().max(reference_mean[c]);
             let sigma = (vg[c] + vr[c] + model * model).sqrt();
             let diff = g[c] - r[c];
             let z = if sigma > 0.0 {
