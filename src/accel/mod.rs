@@ -1,13 +1,15 @@
 //! Ray–scene intersection: the Möller–Trumbore triangle test, a uniform grid per mesh,
-//! and a small top-level structure over the instances.
+//! and a top level over the instances (a list, or a grid of their own when there are many).
 
+mod frame;
 pub mod grid;
 mod instances;
 mod ray;
+mod top_level;
 mod triangle;
 
 pub use grid::{Grid, GridHit, GridStats, TraversalCounts, TraversalStats};
-pub use instances::{SceneAccel, SceneHit};
+pub use instances::{SceneAccel, SceneHit, TopLevel};
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};
 

@@ -27,7 +27,7 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-use crate::accel::SceneAccel;
+use crate::accel::{SceneAccel, TopLevel};
 use crate::scene::{Camera, Scene};
 use sampler::Sampler;
 use sampling::mix64;
@@ -110,9 +110,14 @@ pub struct Renderer<'a> {
 impl<'a> Renderer<'a> {
     /// Builds the acceleration structure and light list for `scene`.
     pub fn new(scene: &'a Scene) -> Renderer<'a> {
+        Renderer::with_top_level(scene, TopLevel::Automatic)
+    }
+
+    /// [`Renderer::new`] with the instances searched as asked (for benchmarks).
+    pub fn with_top_level(scene: &'a Scene, top_level: TopLevel) -> Renderer<'a> {
         Renderer {
             scene,
-            accel: SceneAccel::build(scene),
+            accel: SceneAccel::build_with(scene, top_level),
             lights: LightSet::build(scene),
             frames: InstanceFrame::for_scene(scene),
             has_cutouts: scene.materials.iter().any(|m| m.is_cutout()),

@@ -6,16 +6,12 @@ use rayon::prelude::*;
 use super::overlap::{Polygon, triangle_overlaps_box};
 use super::{DEFAULT_DENSITY, Grid, MACRO_SHIFT};
 use crate::accel::Triangle;
+use crate::accel::frame::{GridFrame, padded, resolution};
 use crate::scene::Aabb;
 
 /// Bounding boxes of at most this many cells are tested cell by cell; larger ones are
 /// walked slab by slab (clipping costs more than it saves on a few cells).
 const SMALL_BOX_CELLS: u64 = 64;
-
-/// Most cells along one axis.
-const MAX_RESOLUTION: u32 = 2048;
-/// Most cells in one grid (the per-cell build counters would otherwise be absurd).
-const MAX_CELLS: u64 = 1 << 28;
 
 impl Grid {
     /// Builds a grid over a triangle soup with the default density.
@@ -81,12 +77,8 @@ impl Grid {
                 within_reference_budget(wanted, bounds, &live_triangles),
             )
         };
-        let cell_size = bounds.extent() / resolution.as_vec3();
         let mut grid = Grid {
-            bounds,
-            resolution,
-            cell_size,
-            inv_cell_size: cell_size.recip(),
+            frame: GridFrame::new(bounds, resolution),
             occupancy: Vec::new(),
             rank: Vec::new(),
             offsets: Vec::new(),
@@ -101,9 +93,10 @@ impl Grid {
         // The estimate above keeps references far below 2^32; should it ever be wrong,
         // halve the resolution rather than overflow the 32-bit offsets.
         while !grid.insert(&triangles, indices, &live) {
-            grid.resolution = (grid.resolution / 2).max(UVec3::ONE);
-            grid.cell_size = grid.bounds.extent() / grid.resolution.as_vec3();
-            grid.inv_cell_size = grid.cell_size.recip();
+            grid.frame = GridFrame::new(
+                grid.frame.bounds,
+                (grid.frame.resolution / 2).max(UVec3::ONE),
+            );
         }
         grid
     }
@@ -133,7 +126,7 @@ impl Grid {
             })
             .collect();
         let references: usize = chunks.iter().map(Vec::len).sum();
-        if references >= u32::MAX as usize && self.resolution != UVec3::ONE {
+        if references >= u32::MAX as usize && self.frame.resolution != UVec3::ONE {
             return false;
         }
         let mut counts = vec![0u32; cells];
@@ -141,7 +134,7 @@ impl Grid {
             counts[cell as usize] += 1;
         }
         // Occupancy bits, ranks and macrocell bits from the counts.
-        let r = self.resolution;
+        let r = self.frame.resolution;
         self.macro_resolution = (r + UVec3::splat((1 << MACRO_SHIFT) - 1)) >> MACRO_SHIFT as u32;
         let m = self.macro_resolution;
         self.occupancy = vec![0; cells.div_ceil(64)];
@@ -194,23 +187,13 @@ impl Grid {
 
     /// Calls `f` with the index of every cell the triangle overlaps.
     fn for_each_overlapped_cell(&self, tri: &Triangle, mut f: impl FnMut(usize)) {
-        // Pad cells a little so rounding never drops a cell the triangle touches: a triangle
-        // lying on a cell face belongs to the cells on both sides.
-        let magnitude = self
-            .bounds
-            .min
-            .abs()
-            .max(self.bounds.max.abs())
-            .max_element();
-        let pad = self.cell_size * 1e-4 + Vec3::splat(magnitude * 1e-6);
-        let b = tri.bounds();
-        let lo = self.cell_of(b.min - pad);
-        let hi = self.cell_of(b.max + pad);
+        let pad = self.frame.pad();
+        let (lo, hi) = self.frame.cells_of_box(&tri.bounds());
         if lo == hi {
             f(self.cell_index(lo));
             return;
         }
-        let half = 0.5 * self.cell_size + pad;
+        let half = 0.5 * self.frame.cell_size + pad;
         let vertices = tri.vertices();
         // Most triangles span a few cells: test every cell of the bounding box.
         let span = hi - lo + UVec3::ONE;
@@ -229,8 +212,9 @@ impl Grid {
         // volume of its bounding box (found by hostile testing: a 100k-corner fan took
         // minutes). Slabs and rows are padded like the cells, so clipping never loses one.
         let slab = |axis: usize, i: u32| {
-            let lo = self.bounds.min[axis] + i as f32 * self.cell_size[axis] - pad[axis];
-            (lo, lo + self.cell_size[axis] + 2.0 * pad[axis])
+            let lo =
+                self.frame.bounds.min[axis] + i as f32 * self.frame.cell_size[axis] - pad[axis];
+            (lo, lo + self.frame.cell_size[axis] + 2.0 * pad[axis])
         };
         let triangle = Polygon::from_triangle(vertices);
         for z in lo.z..=hi.z {
@@ -239,15 +223,15 @@ impl Grid {
             let Some(slab_bounds) = in_slab.bounds() else {
                 continue;
             };
-            let rows =
-                self.cell_of(slab_bounds.min - pad).y..=self.cell_of(slab_bounds.max + pad).y;
+            let rows = self.frame.cell_of(slab_bounds.min - pad).y
+                ..=self.frame.cell_of(slab_bounds.max + pad).y;
             for y in rows {
                 let (y0, y1) = slab(1, y);
                 let Some(row_bounds) = in_slab.clip(1, y0, y1).bounds() else {
                     continue;
                 };
-                let first = self.cell_of(row_bounds.min - pad).x;
-                let last = self.cell_of(row_bounds.max + pad).x;
+                let first = self.frame.cell_of(row_bounds.min - pad).x;
+                let last = self.frame.cell_of(row_bounds.max + pad).x;
                 for x in first..=last {
                     self.report_if_overlapped(vertices, half, UVec3::new(x, y, z), &mut f);
                 }
@@ -264,31 +248,10 @@ impl Grid {
         c: UVec3,
         f: &mut impl FnMut(usize),
     ) {
-        let center = self.bounds.min + (c.as_vec3() + 0.5) * self.cell_size;
+        let center = self.frame.bounds.min + (c.as_vec3() + 0.5) * self.frame.cell_size;
         if triangle_overlaps_box(vertices, center, half) {
             f(self.cell_index(c));
         }
-    }
-
-    /// The cell holding point `p`, clamped into the grid.
-    pub(super) fn cell_of(&self, p: Vec3) -> UVec3 {
-        let c = ((p - self.bounds.min) * self.inv_cell_size).floor();
-        c.max(Vec3::ZERO).as_uvec3().min(self.resolution - 1)
-    }
-}
-
-/// The box grown by a small fraction of its size, so flat meshes get a volume and no
-/// triangle lies exactly on the boundary.
-fn padded(b: Aabb) -> Aabb {
-    let e = b.extent();
-    let pad = Vec3::splat(
-        e.max_element() * 1e-5
-            + 1e-7 * b.min.abs().max(b.max.abs()).max_element()
-            + f32::MIN_POSITIVE,
-    );
-    Aabb {
-        min: b.min - pad,
-        max: b.max + pad,
     }
 }
 
@@ -331,47 +294,4 @@ fn within_reference_budget(wanted: UVec3, bounds: Aabb, triangles: &[Triangle]) 
         r = (r.as_vec3() * shrink).floor().max(Vec3::ONE).as_uvec3();
     }
     r
-}
-
-/// Cells per axis after Cleary & Wyvill (1988): R_a = d_a · ∛(λN / V), which makes cells
-/// near-cubic. In V, thin axes count as at least the cube-root cell size of the longest
-/// axis, so that a flat mesh (a wall, a floor) gets about λN cells in its plane and one
-/// across it, instead of a vast number of slivers.
-fn resolution(extent: Vec3, triangles: usize, density: f32) -> UVec3 {
-    let target = (density * triangles as f32).max(1.0);
-    let floor = extent.max_element() / target.cbrt();
-    let e = extent.max(Vec3::splat(floor));
-    let k = (target / (e.x * e.y * e.z)).cbrt();
-    let mut r = (extent * k)
-        .floor()
-        .max(Vec3::ONE)
-        .min(Vec3::splat(MAX_RESOLUTION as f32))
-        .as_uvec3();
-    while r.x as u64 * r.y as u64 * r.z as u64 > MAX_CELLS {
-        r = (r.as_vec3() * 0.9).max(Vec3::ONE).as_uvec3();
-    }
-    r
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn resolution_follows_density_and_aspect() {
-        let r = resolution(Vec3::new(2.0, 1.0, 1.0), 1000, 5.0);
-        let cells = r.x * r.y * r.z;
-        assert!((2500..=5000).contains(&cells), "{r}");
-        assert!(r.x >= 2 * r.y - 1, "{r}");
-    }
-
-    #[test]
-    fn flat_meshes_get_few_cells() {
-        let r = resolution(Vec3::new(2.0, 1e-5, 2.0), 2, 5.0);
-        assert_eq!(r.y, 1);
-        assert!(r.x * r.z <= 16, "{r}");
-        let r = resolution(Vec3::new(2.0, 4e-5, 2.0), 800, 5.0);
-        assert_eq!(r.y, 1, "{r}");
-        assert!((1000..=4000).contains(&(r.x * r.z)), "{r}");
-    }
 }

@@ -21,6 +21,7 @@ use std::ops::Range;
 use glam::{IVec3, UVec3, Vec3};
 
 use super::Triangle;
+use super::frame::GridFrame;
 use crate::scene::Aabb;
 
 /// Cells per triangle aimed for by the resolution heuristic (λ in Cleary & Wyvill 1988).
@@ -32,14 +33,8 @@ const MACRO_SHIFT: i32 = 3;
 /// A uniform grid accelerating ray queries against one triangle list.
 #[derive(Clone, Debug)]
 pub struct Grid {
-    /// The box the cells tile (the triangles' bounds, slightly padded).
-    bounds: Aabb,
-    /// Cells per axis.
-    resolution: UVec3,
-    /// Size of one cell per axis.
-    cell_size: Vec3,
-    /// `1 / cell_size`.
-    inv_cell_size: Vec3,
+    /// The box the cells tile (the triangles' bounds, slightly padded) and its cells.
+    frame: GridFrame,
     /// One bit per cell (x fastest, then y, then z): set when the cell holds a triangle.
     occupancy: Vec<u64>,
     /// Occupied cells before each word of `occupancy`.
@@ -95,22 +90,22 @@ pub struct GridStats {
 impl Grid {
     /// Bounds of the grid's cells.
     pub fn bounds(&self) -> Aabb {
-        self.bounds
+        self.frame.bounds
     }
 
     /// Cells per axis.
     pub fn resolution(&self) -> UVec3 {
-        self.resolution
+        self.frame.resolution
     }
 
     /// Size of one cell.
     pub fn cell_size(&self) -> Vec3 {
-        self.cell_size
+        self.frame.cell_size
     }
 
     /// Number of cells.
     fn cell_count(&self) -> usize {
-        (self.resolution.x * self.resolution.y * self.resolution.z) as usize
+        self.frame.cell_count()
     }
 
     /// Figures that describe this grid.
@@ -118,7 +113,7 @@ impl Grid {
         let cells = self.cell_count();
         let occupied = self.offsets.len() - 1;
         GridStats {
-            resolution: self.resolution,
+            resolution: self.frame.resolution,
             cells,
             triangles: self.inserted,
             references: self.cell_corners.len(),
@@ -136,7 +131,7 @@ impl Grid {
 
     #[inline]
     fn cell_index(&self, c: UVec3) -> usize {
-        (c.x + self.resolution.x * (c.y + self.resolution.y * c.z)) as usize
+        self.frame.cell_index(c)
     }
 
     /// The `k`-th stored triangle.
@@ -214,9 +209,9 @@ impl Grid {
             return Err("a corner index is past the vertex array".into());
         }
         let mut seen = vec![false; self.triangle_count];
-        for z in 0..self.resolution.z {
-            for y in 0..self.resolution.y {
-                for x in 0..self.resolution.x {
+        for z in 0..self.frame.resolution.z {
+            for y in 0..self.frame.resolution.y {
+                for x in 0..self.frame.resolution.x {
                     let c = UVec3::new(x, y, z);
                     let Some(range) = self.cell_range(self.cell_index(c)) else {
                         continue;
@@ -226,10 +221,10 @@ impl Grid {
                             "cell {c} is occupied but its macrocell is marked empty"
                         ));
                     }
-                    let lo = self.bounds.min + c.as_vec3() * self.cell_size;
+                    let lo = self.frame.bounds.min + c.as_vec3() * self.frame.cell_size;
                     let cell = Aabb {
-                        min: lo - self.cell_size * 1e-3,
-                        max: lo + self.cell_size * 1.001,
+                        min: lo - self.frame.cell_size * 1e-3,
+                        max: lo + self.frame.cell_size * 1.001,
                     };
                     for k in range {
                         let id = self.cell_triangle_ids[k] as usize;

@@ -3,10 +3,11 @@
 //! (so empty cells never touch the offset array) and one per macrocell of
 //! `MACRO_CELLS`³ cells, which the walk crosses in a single step when it is empty.
 
-use glam::{IVec3, Vec3};
+use glam::IVec3;
 
 use super::{Grid, GridHit, MACRO_SHIFT};
 use crate::accel::Ray;
+use crate::accel::frame::CellWalk;
 
 /// Counts the work a traversal does, for the benchmark's statistics. The unit type counts
 /// nothing and compiles away.
@@ -15,6 +16,9 @@ pub trait TraversalStats {
     fn visit_cell(&mut self) {}
     /// One ray–triangle test.
     fn test_triangle(&mut self) {}
+    /// One instance considered by the top level (its bounding box tested, and its grid
+    /// walked if that is hit).
+    fn test_instance(&mut self) {}
 }
 
 impl TraversalStats for () {}
@@ -26,6 +30,8 @@ pub struct TraversalCounts {
     pub cells: u64,
     /// Ray–triangle tests.
     pub tests: u64,
+    /// Instances considered by the top level.
+    pub instances: u64,
 }
 
 impl TraversalStats for TraversalCounts {
@@ -35,43 +41,8 @@ impl TraversalStats for TraversalCounts {
     fn test_triangle(&mut self) {
         self.tests += 1;
     }
-}
-
-/// The walk of one ray through the cells it crosses, front to back.
-struct CellWalk {
-    /// Current cell.
-    cell: IVec3,
-    /// −1, 0 or +1 per axis.
-    step: IVec3,
-    /// The ray crosses the plane of cell face `k` on axis `a` at `t = slope[a]·k + offset[a]`:
-    /// face distances come from integer coordinates, so no error accumulates.
-    slope: Vec3,
-    offset: Vec3,
-    /// Ray parameter at which the ray leaves the current cell, per axis.
-    t_next: Vec3,
-    /// Ray parameter at which the ray leaves the grid (or reaches `t_max`).
-    t_end: f32,
-}
-
-impl CellWalk {
-    /// Parameter of the current cell's far face on `axis` (∞ if the ray is parallel to it).
-    #[inline]
-    fn face_t(&self, axis: usize, face: i32) -> f32 {
-        if self.step[axis] == 0 {
-            f32::INFINITY
-        } else {
-            self.slope[axis] * face as f32 + self.offset[axis]
-        }
-    }
-
-    #[inline]
-    fn far_face(&self, axis: usize) -> i32 {
-        self.cell[axis] + i32::from(self.step[axis] > 0)
-    }
-
-    #[inline]
-    fn refresh(&mut self, axis: usize) {
-        self.t_next[axis] = self.face_t(axis, self.far_face(axis));
+    fn test_instance(&mut self) {
+        self.instances += 1;
     }
 }
 
@@ -137,10 +108,12 @@ impl Grid {
         stats: &mut S,
         mut visit: impl FnMut(&Grid, std::ops::Range<usize>, f32, &mut S) -> bool,
     ) {
-        let Some(mut walk) = self.start_walk(ray) else {
+        if self.cell_corners.is_empty() {
+            return;
+        }
+        let Some(mut walk) = self.frame.start_walk(ray) else {
             return;
         };
-        let res = self.resolution.as_ivec3();
         loop {
             stats.visit_cell();
             if !self.macro_occupied(walk.cell) {
@@ -149,30 +122,24 @@ impl Grid {
                 }
                 continue;
             }
-            let axis = exit_axis(walk.t_next);
-            let t_exit = walk.t_next[axis];
-            let next = walk.cell[axis] + walk.step[axis];
-            let last =
-                walk.step[axis] == 0 || next < 0 || next >= res[axis] || t_exit >= walk.t_end;
+            let exit = walk.exit();
             if let Some(range) = self.cell_range(self.cell_index(walk.cell.as_uvec3())) {
                 // Only hits inside the cell count; the last cell takes all up to the grid's end.
-                let limit = if last { walk.t_end } else { t_exit };
-                if visit(self, range, limit, stats) {
+                if visit(self, range, exit.t, stats) {
                     return;
                 }
             }
-            if last {
+            if exit.last {
                 return;
             }
-            walk.cell[axis] = next;
-            walk.refresh(axis);
+            walk.advance(exit);
         }
     }
 
     /// Moves the walk past the empty macrocell holding its current cell, to the first cell of
     /// the next macrocell along the ray. False when the ray leaves the grid first.
     fn skip_macrocell(&self, walk: &mut CellWalk, ray: &Ray) -> bool {
-        let res = self.resolution.as_ivec3();
+        let res = self.frame.resolution.as_ivec3();
         let macro_lo = (walk.cell >> MACRO_SHIFT) << MACRO_SHIFT;
         let macro_hi = (macro_lo + IVec3::splat((1 << MACRO_SHIFT) - 1)).min(res - 1);
         let mut axis = 0;
@@ -207,7 +174,8 @@ impl Grid {
             if a == axis {
                 walk.cell[a] = next;
             } else if walk.step[a] != 0 {
-                let c = ((p[a] - self.bounds.min[a]) * self.inv_cell_size[a]).floor() as i32;
+                let c = ((p[a] - self.frame.bounds.min[a]) * self.frame.inv_cell_size[a]).floor()
+                    as i32;
                 walk.cell[a] = if walk.step[a] > 0 {
                     c.clamp(walk.cell[a], macro_hi[a])
                 } else {
@@ -217,67 +185,5 @@ impl Grid {
             walk.refresh(a);
         }
         true
-    }
-
-    /// Clips the ray to the grid and finds the first cell; `None` when it misses the grid.
-    fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
-        if self.cell_corners.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
-            return None;
-        }
-        let inv = ray.direction.recip();
-        let t0 = (self.bounds.min - ray.origin) * inv;
-        let t1 = (self.bounds.max - ray.origin) * inv;
-        // f32::max/min skip NaN (0·∞ for an origin on a slab of a parallel axis).
-        let near = t0.min(t1);
-        // Widen each slab's exit by its rounding error, so a ray through the box is never
-        // clipped away by rounding (pbrt-v4 §6.8.2: t_far·(1 + 2γ(3))).
-        let far = t0.max(t1) * (1.0 + 2.0 * crate::accel::SLAB_ROUNDING);
-        let t_start = ray.t_min.max(near.x).max(near.y).max(near.z);
-        let t_end = ray.t_max.min(far.x).min(far.y).min(far.z);
-        // Written so that a NaN bound also counts as a miss.
-        if t_start > t_end || t_start.is_nan() || t_end.is_nan() {
-            return None;
-        }
-        let cell = self.cell_of(ray.at(t_start)).as_ivec3();
-        let step = IVec3::new(
-            step_of(ray.direction.x),
-            step_of(ray.direction.y),
-            step_of(ray.direction.z),
-        );
-        let mut walk = CellWalk {
-            cell,
-            step,
-            slope: self.cell_size * inv,
-            offset: t0,
-            t_next: Vec3::INFINITY,
-            t_end,
-        };
-        for axis in 0..3 {
-            walk.refresh(axis);
-        }
-        Some(walk)
-    }
-}
-
-/// The axis whose cell face the ray crosses first.
-#[inline]
-fn exit_axis(t_next: Vec3) -> usize {
-    if t_next.x <= t_next.y && t_next.x <= t_next.z {
-        0
-    } else if t_next.y <= t_next.z {
-        1
-    } else {
-        2
-    }
-}
-
-#[inline]
-fn step_of(d: f32) -> i32 {
-    if d > 0.0 {
-        1
-    } else if d < 0.0 {
-        -1
-    } else {
-        0
     }
 }

@@ -1,0 +1,291 @@
+//! What every uniform grid here shares, over triangles or over instances: a box cut into
+//! near-cubic cells, the cell under a point, and the 3D-DDA walk of Amanatides & Woo (1987),
+//! "A fast voxel traversal algorithm for ray tracing", through the cells a ray crosses.
+
+use glam::{IVec3, UVec3, Vec3};
+
+use super::Ray;
+use crate::scene::Aabb;
+
+/// Most cells along one axis.
+pub(crate) const MAX_RESOLUTION: u32 = 2048;
+/// Most cells in one grid (per-cell build counters would otherwise be absurd).
+pub(crate) const MAX_CELLS: u64 = 1 << 28;
+
+/// A box tiled by `resolution` equal cells, numbered x fastest, then y, then z.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct GridFrame {
+    /// The box the cells tile.
+    pub bounds: Aabb,
+    /// Cells per axis.
+    pub resolution: UVec3,
+    /// Size of one cell per axis.
+    pub cell_size: Vec3,
+    /// `1 / cell_size`.
+    pub inv_cell_size: Vec3,
+}
+
+impl GridFrame {
+    /// `bounds` cut into `resolution` cells.
+    pub fn new(bounds: Aabb, resolution: UVec3) -> GridFrame {
+        let cell_size = bounds.extent() / resolution.as_vec3();
+        GridFrame {
+            bounds,
+            resolution,
+            cell_size,
+            inv_cell_size: cell_size.recip(),
+        }
+    }
+
+    /// Number of cells.
+    pub fn cell_count(&self) -> usize {
+        self.resolution.x as usize * self.resolution.y as usize * self.resolution.z as usize
+    }
+
+    /// Index of cell `c`.
+    #[inline]
+    pub fn cell_index(&self, c: UVec3) -> usize {
+        (c.x + self.resolution.x * (c.y + self.resolution.y * c.z)) as usize
+    }
+
+    /// The cell holding point `p`, clamped into the grid.
+    #[inline]
+    pub fn cell_of(&self, p: Vec3) -> UVec3 {
+        let c = ((p - self.bounds.min) * self.inv_cell_size).floor();
+        c.max(Vec3::ZERO).as_uvec3().min(self.resolution - 1)
+    }
+
+    /// How far cells are grown when deciding what they hold, so that rounding never drops
+    /// a cell something touches: whatever lies on a cell face belongs to both sides.
+    pub fn pad(&self) -> Vec3 {
+        let magnitude = self
+            .bounds
+            .min
+            .abs()
+            .max(self.bounds.max.abs())
+            .max_element();
+        self.cell_size * 1e-4 + Vec3::splat(magnitude * 1e-6)
+    }
+
+    /// The cells (inclusive corners) a box touches, cells grown by [`GridFrame::pad`].
+    pub fn cells_of_box(&self, b: &Aabb) -> (UVec3, UVec3) {
+        let pad = self.pad();
+        (self.cell_of(b.min - pad), self.cell_of(b.max + pad))
+    }
+
+    /// Clips the ray to the box and finds the first cell; `None` when it misses the box.
+    pub fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
+        if !(ray.origin.is_finite() && ray.direction.is_finite()) {
+            return None;
+        }
+        let inv = ray.direction.recip();
+        let t0 = (self.bounds.min - ray.origin) * inv;
+        let t1 = (self.bounds.max - ray.origin) * inv;
+        // f32::max/min skip NaN (0·∞ for an origin on a slab of a parallel axis).
+        let near = t0.min(t1);
+        // Widen each slab's exit by its rounding error, so a ray through the box is never
+        // clipped away by rounding (pbrt-v4 §6.8.2: t_far·(1 + 2γ(3))).
+        let far = t0.max(t1) * (1.0 + 2.0 * super::SLAB_ROUNDING);
+        let t_start = ray.t_min.max(near.x).max(near.y).max(near.z);
+        let t_end = ray.t_max.min(far.x).min(far.y).min(far.z);
+        // Written so that a NaN bound also counts as a miss.
+        if t_start > t_end || t_start.is_nan() || t_end.is_nan() {
+            return None;
+        }
+        let cell = self.cell_of(ray.at(t_start)).as_ivec3();
+        let step = IVec3::new(
+            step_of(ray.direction.x),
+            step_of(ray.direction.y),
+            step_of(ray.direction.z),
+        );
+        let mut walk = CellWalk {
+            cell,
+            step,
+            slope: self.cell_size * inv,
+            offset: t0,
+            t_next: Vec3::INFINITY,
+            t_end,
+            resolution: self.resolution.as_ivec3(),
+        };
+        for axis in 0..3 {
+            walk.refresh(axis);
+        }
+        Some(walk)
+    }
+}
+
+/// Where the walk leaves the current cell.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CellExit {
+    /// The axis whose face the ray crosses first.
+    pub axis: usize,
+    /// Ray parameter at that face.
+    pub t: f32,
+    /// True when no cell follows (the ray leaves the grid or reaches its end here).
+    pub last: bool,
+}
+
+/// The walk of one ray through the cells it crosses, front to back.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CellWalk {
+    /// Current cell.
+    pub cell: IVec3,
+    /// −1, 0 or +1 per axis.
+    pub step: IVec3,
+    /// The ray crosses the plane of cell face `k` on axis `a` at `t = slope[a]·k + offset[a]`:
+    /// face distances come from integer coordinates, so no error accumulates.
+    slope: Vec3,
+    offset: Vec3,
+    /// Ray parameter at which the ray leaves the current cell, per axis.
+    t_next: Vec3,
+    /// Ray parameter at which the ray leaves the grid (or reaches `t_max`).
+    pub t_end: f32,
+    resolution: IVec3,
+}
+
+impl CellWalk {
+    /// Parameter of the plane of cell face `face` on `axis` (∞ if the ray is parallel to it).
+    #[inline]
+    pub fn face_t(&self, axis: usize, face: i32) -> f32 {
+        if self.step[axis] == 0 {
+            f32::INFINITY
+        } else {
+            self.slope[axis] * face as f32 + self.offset[axis]
+        }
+    }
+
+    /// Recomputes where the ray leaves the current cell on `axis`.
+    #[inline]
+    pub fn refresh(&mut self, axis: usize) {
+        let far_face = self.cell[axis] + i32::from(self.step[axis] > 0);
+        self.t_next[axis] = self.face_t(axis, far_face);
+    }
+
+    /// Where the ray leaves the current cell; only hits up to `t` belong to it (up to
+    /// `t_end` in the last cell).
+    #[inline]
+    pub fn exit(&self) -> CellExit {
+        let t = self.t_next;
+        let axis = if t.x <= t.y && t.x <= t.z {
+            0
+        } else if t.y <= t.z {
+            1
+        } else {
+            2
+        };
+        let next = self.cell[axis] + self.step[axis];
+        let last = self.step[axis] == 0
+            || next < 0
+            || next >= self.resolution[axis]
+            || t[axis] >= self.t_end;
+        CellExit {
+            axis,
+            t: if last { self.t_end } else { t[axis] },
+            last,
+        }
+    }
+
+    /// Moves to the next cell through the face `exit` found.
+    #[inline]
+    pub fn advance(&mut self, exit: CellExit) {
+        self.cell[exit.axis] += self.step[exit.axis];
+        self.refresh(exit.axis);
+    }
+}
+
+#[inline]
+fn step_of(d: f32) -> i32 {
+    if d > 0.0 {
+        1
+    } else if d < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// The box grown by a small fraction of its size, so flat contents get a volume and nothing
+/// lies exactly on the boundary.
+pub(crate) fn padded(b: Aabb) -> Aabb {
+    let e = b.extent();
+    let pad = Vec3::splat(
+        e.max_element() * 1e-5
+            + 1e-7 * b.min.abs().max(b.max.abs()).max_element()
+            + f32::MIN_POSITIVE,
+    );
+    Aabb {
+        min: b.min - pad,
+        max: b.max + pad,
+    }
+}
+
+/// Cells per axis after Cleary & Wyvill (1988): R_a = d_a · ∛(λN / V), which makes cells
+/// near-cubic. In V, thin axes count as at least the cube-root cell size of the longest
+/// axis, so that flat contents (a wall, a floor, objects on a plane) get about λN cells in
+/// their plane and one across it, instead of a vast number of slivers.
+pub(crate) fn resolution(extent: Vec3, items: usize, density: f32) -> UVec3 {
+    let target = (density * items as f32).max(1.0);
+    let floor = extent.max_element() / target.cbrt();
+    let e = extent.max(Vec3::splat(floor));
+    let k = (target / (e.x * e.y * e.z)).cbrt();
+    let mut r = (extent * k)
+        .floor()
+        .max(Vec3::ONE)
+        .min(Vec3::splat(MAX_RESOLUTION as f32))
+        .as_uvec3();
+    while r.x as u64 * r.y as u64 * r.z as u64 > MAX_CELLS {
+        r = (r.as_vec3() * 0.9).max(Vec3::ONE).as_uvec3();
+    }
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolution_follows_density_and_aspect() {
+        let r = resolution(Vec3::new(2.0, 1.0, 1.0), 1000, 5.0);
+        let cells = r.x * r.y * r.z;
+        assert!((2500..=5000).contains(&cells), "{r}");
+        assert!(r.x >= 2 * r.y - 1, "{r}");
+    }
+
+    #[test]
+    fn flat_contents_get_few_cells() {
+        let r = resolution(Vec3::new(2.0, 1e-5, 2.0), 2, 5.0);
+        assert_eq!(r.y, 1);
+        assert!(r.x * r.z <= 16, "{r}");
+        let r = resolution(Vec3::new(2.0, 4e-5, 2.0), 800, 5.0);
+        assert_eq!(r.y, 1, "{r}");
+        assert!((1000..=4000).contains(&(r.x * r.z)), "{r}");
+    }
+
+    #[test]
+    fn a_walk_visits_the_cells_a_diagonal_ray_crosses_in_order() {
+        let frame = GridFrame::new(
+            Aabb {
+                min: Vec3::ZERO,
+                max: Vec3::splat(4.0),
+            },
+            UVec3::splat(4),
+        );
+        let ray = Ray::new(Vec3::new(-1.0, 0.5, 0.5), Vec3::new(1.0, 0.0, 0.0));
+        let mut walk = frame.start_walk(&ray).unwrap();
+        let mut cells = vec![walk.cell];
+        loop {
+            let exit = walk.exit();
+            if exit.last {
+                assert_eq!(exit.t, walk.t_end);
+                break;
+            }
+            assert_eq!(exit.t, (walk.cell.x + 2) as f32);
+            walk.advance(exit);
+            cells.push(walk.cell);
+        }
+        assert_eq!(
+            cells,
+            (0..4).map(|x| IVec3::new(x, 0, 0)).collect::<Vec<_>>()
+        );
+    }
+}
