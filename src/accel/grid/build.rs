@@ -3,6 +3,7 @@
 use glam::{UVec3, Vec3};
 use rayon::prelude::*;
 
+use super::block::{Block, LANES};
 use super::overlap::{Polygon, triangle_overlaps_box};
 use super::{DEFAULT_DENSITY, Grid, MACRO_SHIFT};
 use crate::accel::Triangle;
@@ -82,9 +83,8 @@ impl Grid {
             occupancy: Vec::new(),
             rank: Vec::new(),
             offsets: Vec::new(),
-            vertices,
-            cell_corners: Vec::new(),
-            cell_triangle_ids: Vec::new(),
+            blocks: Vec::new(),
+            references: 0,
             macro_resolution: UVec3::ONE,
             macro_occupancy: Vec::new(),
             triangle_count: indices.len(),
@@ -92,7 +92,7 @@ impl Grid {
         };
         // The estimate above keeps references far below 2^32; should it ever be wrong,
         // halve the resolution rather than overflow the 32-bit offsets.
-        while !grid.insert(&triangles, indices, &live) {
+        while !grid.insert(&triangles, &live) {
             grid.frame = GridFrame::new(
                 grid.frame.bounds,
                 (grid.frame.resolution / 2).max(UVec3::ONE),
@@ -106,12 +106,7 @@ impl Grid {
     /// (count → prefix sum → place) then lays them out. Within a cell, triangles keep mesh
     /// order whatever the thread count, so ties between equal hits resolve the same way.
     /// False, with nothing changed, if there are more references than 32-bit offsets hold.
-    fn insert(
-        &mut self,
-        triangles: &[Option<Triangle>],
-        indices: &[[u32; 3]],
-        live: &[u32],
-    ) -> bool {
+    fn insert(&mut self, triangles: &[Option<Triangle>], live: &[u32]) -> bool {
         let cells = self.cell_count();
         let chunks: Vec<Vec<(u32, u32)>> = live
             .par_chunks(4096)
@@ -162,26 +157,24 @@ impl Grid {
                 before
             })
             .collect();
-        // Offsets of the occupied cells; `counts` becomes each cell's next free slot.
+        // Block offsets of the occupied cells; `counts` becomes each cell's next free lane.
         self.offsets = Vec::with_capacity(occupied as usize + 1);
         let mut total = 0u32;
         for n in counts.iter_mut().filter(|n| **n > 0) {
             self.offsets.push(total);
-            let here = *n;
-            *n = total;
-            total += here;
+            let blocks = n.div_ceil(LANES as u32);
+            *n = total * LANES as u32;
+            total += blocks;
         }
         self.offsets.push(total);
-        let mut cell_corners = vec![[0u32; 3]; total as usize];
-        let mut cell_triangle_ids = vec![0u32; total as usize];
+        let mut blocks = vec![Block::EMPTY; total as usize];
         for &(cell, t) in chunks.iter().flatten() {
             let slot = counts[cell as usize] as usize;
-            cell_corners[slot] = indices[t as usize];
-            cell_triangle_ids[slot] = t;
+            blocks[slot / LANES].set(slot % LANES, &triangles[t as usize].unwrap(), t);
             counts[cell as usize] += 1;
         }
-        self.cell_corners = cell_corners;
-        self.cell_triangle_ids = cell_triangle_ids;
+        self.blocks = blocks;
+        self.references = references;
         true
     }
 

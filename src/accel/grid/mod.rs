@@ -3,13 +3,14 @@
 //! Triangles go only into the cells they really overlap (triangle–box separating-axis
 //! test). Storage is compact (after Lagae & Dutré 2008): one occupancy bit per cell, a
 //! running count of occupied cells per 64-bit word (so an occupied cell's rank is one
-//! popcount away), offsets for occupied cells only, and each cell's triangles as corner
-//! indices into one vertex array, cell after cell, so a cell's triangles sit together in
-//! memory and the vertices (shared, a few megabytes) stay in cache. A second bit array marks the
+//! popcount away), offsets for occupied cells only, and each cell's triangles copied in
+//! blocks of eight, vertex and edges lane by lane, cell after cell, so a cell's triangles
+//! are one contiguous read and are tested eight at a time ([`block`]). A second bit array marks the
 //! occupied macrocells of `2^MACRO_SHIFT`³ cells, which lets the walk cross empty space in
 //! large steps. Traversal is the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if
 //! it lies within the current cell.
 
+mod block;
 mod build;
 mod overlap;
 mod traverse;
@@ -20,7 +21,8 @@ use std::ops::Range;
 
 use glam::{IVec3, UVec3, Vec3};
 
-use super::Triangle;
+use block::Block;
+
 use super::frame::GridFrame;
 use crate::scene::Aabb;
 
@@ -39,14 +41,12 @@ pub struct Grid {
     occupancy: Vec<u64>,
     /// Occupied cells before each word of `occupancy`.
     rank: Vec<u32>,
-    /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes `cell_corners`.
+    /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes `blocks`.
     offsets: Vec<u32>,
-    /// Vertex positions.
-    vertices: Vec<Vec3>,
-    /// The corners of the triangles of every occupied cell, cell after cell.
-    cell_corners: Vec<[u32; 3]>,
-    /// The mesh index of each entry of `cell_corners`.
-    cell_triangle_ids: Vec<u32>,
+    /// The triangles of every occupied cell, eight to a block, cell after cell.
+    blocks: Vec<Block>,
+    /// Triangle references in `blocks` (lanes in use).
+    references: usize,
     /// Macrocells per axis.
     macro_resolution: UVec3,
     /// One bit per macrocell: set when any of its cells holds a triangle.
@@ -116,15 +116,13 @@ impl Grid {
             resolution: self.frame.resolution,
             cells,
             triangles: self.inserted,
-            references: self.cell_corners.len(),
+            references: self.references,
             empty_fraction: 1.0 - occupied as f64 / cells as f64,
             bytes: std::mem::size_of::<Grid>()
                 + std::mem::size_of_val(self.occupancy.as_slice())
                 + std::mem::size_of_val(self.rank.as_slice())
                 + std::mem::size_of_val(self.offsets.as_slice())
-                + std::mem::size_of_val(self.vertices.as_slice())
-                + std::mem::size_of_val(self.cell_corners.as_slice())
-                + std::mem::size_of_val(self.cell_triangle_ids.as_slice())
+                + std::mem::size_of_val(self.blocks.as_slice())
                 + std::mem::size_of_val(self.macro_occupancy.as_slice()),
         }
     }
@@ -134,18 +132,7 @@ impl Grid {
         self.frame.cell_index(c)
     }
 
-    /// The `k`-th stored triangle.
-    #[inline]
-    fn cell_triangle(&self, k: usize) -> Triangle {
-        let [a, b, c] = self.cell_corners[k];
-        Triangle::new(
-            self.vertices[a as usize],
-            self.vertices[b as usize],
-            self.vertices[c as usize],
-        )
-    }
-
-    /// Where the triangles of cell `index` lie in `cell_corners`; `None` for empty cells.
+    /// Where the blocks of cell `index` lie in `blocks`; `None` for empty cells.
     #[inline]
     fn cell_range(&self, index: usize) -> Option<Range<usize>> {
         let word = self.occupancy[index >> 6];
@@ -195,18 +182,13 @@ impl Grid {
         if self.offsets.windows(2).any(|w| w[0] >= w[1]) {
             return Err("an occupied cell is empty or offsets decrease".into());
         }
-        if *self.offsets.last().unwrap() as usize != self.cell_corners.len()
-            || self.cell_triangle_ids.len() != self.cell_corners.len()
-        {
-            return Err("offsets, corners and ids disagree in length".into());
+        if *self.offsets.last().unwrap() as usize != self.blocks.len() {
+            return Err("offsets and blocks disagree in length".into());
         }
-        if self
-            .cell_corners
-            .iter()
-            .flatten()
-            .any(|&i| i as usize >= self.vertices.len())
+        if self.blocks.iter().any(|b| b.len() == 0)
+            || self.blocks.iter().map(Block::len).sum::<usize>() != self.references
         {
-            return Err("a corner index is past the vertex array".into());
+            return Err("a block is empty, or the blocks hold the wrong reference count".into());
         }
         let mut seen = vec![false; self.triangle_count];
         for z in 0..self.frame.resolution.z {
@@ -226,9 +208,11 @@ impl Grid {
                         min: lo - self.frame.cell_size * 1e-3,
                         max: lo + self.frame.cell_size * 1.001,
                     };
-                    for k in range {
-                        let id = self.cell_triangle_ids[k] as usize;
-                        let b = self.cell_triangle(k).bounds();
+                    let stored = range
+                        .flat_map(|k| (0..block::LANES).filter_map(move |l| self.blocks[k].get(l)));
+                    for (triangle, id) in stored {
+                        let id = id as usize;
+                        let b = triangle.bounds();
                         if id >= self.triangle_count {
                             return Err(format!(
                                 "cell {c} refers to triangle {id} of {}",

@@ -14,8 +14,8 @@ use crate::accel::frame::CellWalk;
 pub trait TraversalStats {
     /// One cell (or one skipped macrocell) stepped through.
     fn visit_cell(&mut self) {}
-    /// One ray–triangle test.
-    fn test_triangle(&mut self) {}
+    /// Ray–triangle tests (the triangles of one block, tested together).
+    fn test_triangles(&mut self, _count: usize) {}
     /// One instance considered by the top level (its bounding box tested, and its grid
     /// walked if that is hit).
     fn test_instance(&mut self) {}
@@ -38,8 +38,8 @@ impl TraversalStats for TraversalCounts {
     fn visit_cell(&mut self) {
         self.cells += 1;
     }
-    fn test_triangle(&mut self) {
-        self.tests += 1;
+    fn test_triangles(&mut self, count: usize) {
+        self.tests += count as u64;
     }
     fn test_instance(&mut self) {
         self.instances += 1;
@@ -63,16 +63,15 @@ impl Grid {
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
         self.walk(ray, stats, |grid, range, limit, stats| {
-            for k in range {
-                let id = grid.cell_triangle_ids[k];
-                stats.test_triangle();
-                if let Some(hit) = grid.cell_triangle(k).intersect(ray, t_nearest) {
+            for block in &grid.blocks[range] {
+                stats.test_triangles(block.len());
+                if let Some(hit) = block.nearest(ray, t_nearest) {
                     t_nearest = hit.t;
                     nearest = Some(GridHit {
                         t: hit.t,
                         u: hit.u,
                         v: hit.v,
-                        triangle: id,
+                        triangle: hit.id,
                     });
                 }
             }
@@ -90,9 +89,9 @@ impl Grid {
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         let mut blocked = false;
         self.walk(ray, stats, |grid, range, _limit, stats| {
-            blocked = range.into_iter().any(|k| {
-                stats.test_triangle();
-                grid.cell_triangle(k).intersect(ray, ray.t_max).is_some()
+            blocked = grid.blocks[range].iter().any(|block| {
+                stats.test_triangles(block.len());
+                block.any(ray, ray.t_max)
             });
             blocked
         });
@@ -100,7 +99,7 @@ impl Grid {
     }
 
     /// Walks the non-empty cells along `ray` in order, calling `visit` with where each cell's
-    /// triangles lie in `cell_corners` and the largest hit parameter that belongs to the
+    /// blocks lie in `blocks` and the largest hit parameter that belongs to the
     /// cell, until `visit` returns true or the ray leaves the grid.
     fn walk<S: TraversalStats>(
         &self,
@@ -108,7 +107,7 @@ impl Grid {
         stats: &mut S,
         mut visit: impl FnMut(&Grid, std::ops::Range<usize>, f32, &mut S) -> bool,
     ) {
-        if self.cell_corners.is_empty() {
+        if self.blocks.is_empty() {
             return;
         }
         let Some(mut walk) = self.frame.start_walk(ray) else {
