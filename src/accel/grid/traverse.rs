@@ -58,12 +58,31 @@ impl Grid {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2, checked just above.
+            return unsafe { self.intersect_avx2(ray, stats) };
+        }
+        self.intersect_portable(ray, stats)
+    }
+
+    /// [`Grid::intersect_portable`] compiled for AVX2, where a block's eight lanes are one
+    /// vector (the arithmetic, and so the answer, is the same).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn intersect_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
+        self.intersect_portable(ray, stats)
+    }
+
+    #[inline(always)]
+    fn intersect_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
         // The nearest hit found so far, wherever it lies; it is the answer once it lies
         // within the cell being visited, since every later cell lies beyond that cell.
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
-        self.walk(ray, stats, |grid, range, limit, stats| {
-            for block in &grid.blocks[range] {
+        let mut cells = self.occupied_cells(ray);
+        while let Some((range, limit)) = cells.next(stats) {
+            for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
                 if let Some(hit) = block.nearest(ray, t_nearest) {
                     t_nearest = hit.t;
@@ -75,8 +94,10 @@ impl Grid {
                     });
                 }
             }
-            t_nearest <= limit
-        });
+            if t_nearest <= limit {
+                break;
+            }
+        }
         nearest
     }
 
@@ -87,51 +108,47 @@ impl Grid {
 
     /// [`Grid::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        let mut blocked = false;
-        self.walk(ray, stats, |grid, range, _limit, stats| {
-            blocked = grid.blocks[range].iter().any(|block| {
-                stats.test_triangles(block.len());
-                block.any(ray, ray.t_max)
-            });
-            blocked
-        });
-        blocked
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2, checked just above.
+            return unsafe { self.occluded_avx2(ray, stats) };
+        }
+        self.occluded_portable(ray, stats)
     }
 
-    /// Walks the non-empty cells along `ray` in order, calling `visit` with where each cell's
-    /// blocks lie in `blocks` and the largest hit parameter that belongs to the
-    /// cell, until `visit` returns true or the ray leaves the grid.
-    fn walk<S: TraversalStats>(
-        &self,
-        ray: &Ray,
-        stats: &mut S,
-        mut visit: impl FnMut(&Grid, std::ops::Range<usize>, f32, &mut S) -> bool,
-    ) {
-        if self.blocks.is_empty() {
-            return;
+    /// [`Grid::occluded_portable`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn occluded_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        self.occluded_portable(ray, stats)
+    }
+
+    #[inline(always)]
+    fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        let mut cells = self.occupied_cells(ray);
+        while let Some((range, _)) = cells.next(stats) {
+            for block in &self.blocks[range] {
+                stats.test_triangles(block.len());
+                if block.any(ray, ray.t_max) {
+                    return true;
+                }
+            }
         }
-        let Some(mut walk) = self.frame.start_walk(ray) else {
-            return;
+        false
+    }
+
+    /// The occupied cells along `ray`, front to back.
+    #[inline(always)]
+    fn occupied_cells<'a>(&'a self, ray: &'a Ray) -> OccupiedCells<'a> {
+        let walk = if self.blocks.is_empty() {
+            None
+        } else {
+            self.frame.start_walk(ray)
         };
-        loop {
-            stats.visit_cell();
-            if !self.macro_occupied(walk.cell) {
-                if !self.skip_macrocell(&mut walk, ray) {
-                    return;
-                }
-                continue;
-            }
-            let exit = walk.exit();
-            if let Some(range) = self.cell_range(self.cell_index(walk.cell.as_uvec3())) {
-                // Only hits inside the cell count; the last cell takes all up to the grid's end.
-                if visit(self, range, exit.t, stats) {
-                    return;
-                }
-            }
-            if exit.last {
-                return;
-            }
-            walk.advance(exit);
+        OccupiedCells {
+            grid: self,
+            ray,
+            walk,
         }
     }
 
@@ -184,5 +201,44 @@ impl Grid {
             walk.refresh(a);
         }
         true
+    }
+}
+
+/// The occupied cells along a ray, front to back (a cursor rather than an iterator, so the
+/// caller's statistics can ride along).
+struct OccupiedCells<'a> {
+    grid: &'a Grid,
+    ray: &'a Ray,
+    /// `None` once the ray has left the grid.
+    walk: Option<CellWalk>,
+}
+
+impl OccupiedCells<'_> {
+    /// Where the next occupied cell's blocks lie in `blocks`, and the largest hit parameter
+    /// that belongs to the cell (the last cell takes all up to the grid's end).
+    #[inline(always)]
+    fn next(&mut self, stats: &mut impl TraversalStats) -> Option<(std::ops::Range<usize>, f32)> {
+        let grid = self.grid;
+        let walk = self.walk.as_mut()?;
+        loop {
+            stats.visit_cell();
+            if !grid.macro_occupied(walk.cell) {
+                if !grid.skip_macrocell(walk, self.ray) {
+                    self.walk = None;
+                    return None;
+                }
+                continue;
+            }
+            let exit = walk.exit();
+            let range = grid.cell_range(grid.cell_index(walk.cell.as_uvec3()));
+            if exit.last {
+                self.walk = None;
+                return range.map(|r| (r, exit.t));
+            }
+            walk.advance(exit);
+            if let Some(range) = range {
+                return Some((range, exit.t));
+            }
+        }
     }
 }
