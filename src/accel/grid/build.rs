@@ -4,8 +4,9 @@ use glam::{UVec3, Vec3};
 use rayon::prelude::*;
 
 use super::block::{Block, LANES};
+use super::cells::{CellIndex, MACRO_CELLS};
 use super::overlap::{Polygon, triangle_overlaps_box};
-use super::{DEFAULT_DENSITY, Grid, MACRO_SHIFT};
+use super::{DEFAULT_DENSITY, Grid};
 use crate::accel::Triangle;
 use crate::accel::frame::{GridFrame, padded, resolution};
 use crate::scene::Aabb;
@@ -80,13 +81,9 @@ impl Grid {
         };
         let mut grid = Grid {
             frame: GridFrame::new(bounds, resolution),
-            occupancy: Vec::new(),
-            rank: Vec::new(),
-            offsets: Vec::new(),
+            cells: CellIndex::default(),
             blocks: Vec::new(),
             references: 0,
-            macro_resolution: UVec3::ONE,
-            macro_occupancy: Vec::new(),
             triangle_count: indices.len(),
             inserted: live.len(),
         };
@@ -107,7 +104,8 @@ impl Grid {
     /// order whatever the thread count, so ties between equal hits resolve the same way.
     /// False, with nothing changed, if there are more references than 32-bit offsets hold.
     fn insert(&mut self, triangles: &[Option<Triangle>], live: &[u32]) -> bool {
-        let cells = self.cell_count();
+        let m = CellIndex::macro_resolution_for(self.frame.resolution);
+        let keys = (m.x * m.y * m.z) as usize * MACRO_CELLS;
         let chunks: Vec<Vec<(u32, u32)>> = live
             .par_chunks(4096)
             .map(|chunk| {
@@ -124,66 +122,32 @@ impl Grid {
         if references >= u32::MAX as usize && self.frame.resolution != UVec3::ONE {
             return false;
         }
-        let mut counts = vec![0u32; cells];
-        for &(cell, _) in chunks.iter().flatten() {
-            counts[cell as usize] += 1;
+        let mut counts = vec![0u32; keys];
+        for &(key, _) in chunks.iter().flatten() {
+            counts[key as usize] += 1;
         }
-        // Occupancy bits, ranks and macrocell bits from the counts.
-        let r = self.frame.resolution;
-        self.macro_resolution = (r + UVec3::splat((1 << MACRO_SHIFT) - 1)) >> MACRO_SHIFT as u32;
-        let m = self.macro_resolution;
-        self.occupancy = vec![0; cells.div_ceil(64)];
-        self.macro_occupancy = vec![0; ((m.x * m.y * m.z) as usize).div_ceil(64)];
-        for (i, &n) in counts.iter().enumerate() {
-            if n > 0 {
-                self.occupancy[i >> 6] |= 1 << (i & 63);
-                let c = UVec3::new(
-                    i as u32 % r.x,
-                    (i as u32 / r.x) % r.y,
-                    i as u32 / (r.x * r.y),
-                );
-                let mc = c >> MACRO_SHIFT as u32;
-                let mi = (mc.x + m.x * (mc.y + m.y * mc.z)) as usize;
-                self.macro_occupancy[mi >> 6] |= 1 << (mi & 63);
-            }
-        }
-        let mut occupied = 0u32;
-        self.rank = self
-            .occupancy
-            .iter()
-            .map(|w| {
-                let before = occupied;
-                occupied += w.count_ones();
-                before
-            })
-            .collect();
-        // Block offsets of the occupied cells; `counts` becomes each cell's next free lane.
-        self.offsets = Vec::with_capacity(occupied as usize + 1);
-        let mut total = 0u32;
-        for n in counts.iter_mut().filter(|n| **n > 0) {
-            self.offsets.push(total);
-            let blocks = n.div_ceil(LANES as u32);
-            *n = total * LANES as u32;
-            total += blocks;
-        }
-        self.offsets.push(total);
-        let mut blocks = vec![Block::EMPTY; total as usize];
-        for &(cell, t) in chunks.iter().flatten() {
-            let slot = counts[cell as usize] as usize;
+        let blocks_per_cell: Vec<u32> = counts.iter().map(|n| n.div_ceil(LANES as u32)).collect();
+        let (cells, first_block) = CellIndex::build(self.frame.resolution, &blocks_per_cell);
+        // Each cell's next free lane.
+        let mut next: Vec<u32> = first_block.iter().map(|&b| b * LANES as u32).collect();
+        let mut blocks = vec![Block::EMPTY; cells.block_count()];
+        for &(key, t) in chunks.iter().flatten() {
+            let slot = next[key as usize] as usize;
             blocks[slot / LANES].set(slot % LANES, &triangles[t as usize].unwrap(), t);
-            counts[cell as usize] += 1;
+            next[key as usize] += 1;
         }
+        self.cells = cells;
         self.blocks = blocks;
         self.references = references;
         true
     }
 
-    /// Calls `f` with the index of every cell the triangle overlaps.
+    /// Calls `f` with the storage key of every cell the triangle overlaps.
     fn for_each_overlapped_cell(&self, tri: &Triangle, mut f: impl FnMut(usize)) {
         let pad = self.frame.pad();
         let (lo, hi) = self.frame.cells_of_box(&tri.bounds());
         if lo == hi {
-            f(self.cell_index(lo));
+            f(self.storage_key(lo));
             return;
         }
         let half = 0.5 * self.frame.cell_size + pad;
@@ -243,7 +207,7 @@ impl Grid {
     ) {
         let center = self.frame.bounds.min + (c.as_vec3() + 0.5) * self.frame.cell_size;
         if triangle_overlaps_box(vertices, center, half) {
-            f(self.cell_index(c));
+            f(self.storage_key(c));
         }
     }
 }

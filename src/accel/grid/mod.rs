@@ -1,27 +1,26 @@
 //! A uniform grid over one mesh's triangles, in object space.
 //!
 //! Triangles go only into the cells they really overlap (triangle–box separating-axis
-//! test). Storage is compact (after Lagae & Dutré 2008): one occupancy bit per cell, a
-//! running count of occupied cells per 64-bit word (so an occupied cell's rank is one
-//! popcount away), offsets for occupied cells only, and each cell's triangles copied in
-//! blocks of eight, vertex and edges lane by lane, cell after cell, so a cell's triangles
-//! are one contiguous read and are tested eight at a time ([`block`]). A second bit array marks the
-//! occupied macrocells of `2^MACRO_SHIFT`³ cells, which lets the walk cross empty space in
-//! large steps. Traversal is the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if
+//! test). Storage is compact (after Lagae & Dutré 2008): offsets for occupied cells only,
+//! found through a two-level index of macrocell records ([`cells`]), and each cell's
+//! triangles copied in blocks of eight, vertex and edges lane by lane, cell after cell, so
+//! a cell's triangles are one contiguous read and are tested eight at a time ([`block`]).
+//! Empty macrocells know their distance to the nearest occupied one, so the walk leaps over
+//! empty space. Traversal is the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if
 //! it lies within the current cell.
 
 mod block;
 mod build;
+mod cells;
 mod overlap;
 mod traverse;
 
 pub use traverse::{TraversalCounts, TraversalStats};
 
-use std::ops::Range;
-
-use glam::{IVec3, UVec3, Vec3};
+use glam::{UVec3, Vec3};
 
 use block::Block;
+use cells::{CellIndex, Lookup};
 
 use super::frame::GridFrame;
 use crate::scene::Aabb;
@@ -29,28 +28,17 @@ use crate::scene::Aabb;
 /// Cells per triangle aimed for by the resolution heuristic (λ in Cleary & Wyvill 1988).
 pub const DEFAULT_DENSITY: f32 = 5.0;
 
-/// A macrocell is 2^MACRO_SHIFT cells along each axis.
-const MACRO_SHIFT: i32 = 3;
-
 /// A uniform grid accelerating ray queries against one triangle list.
 #[derive(Clone, Debug)]
 pub struct Grid {
     /// The box the cells tile (the triangles' bounds, slightly padded) and its cells.
     frame: GridFrame,
-    /// One bit per cell (x fastest, then y, then z): set when the cell holds a triangle.
-    occupancy: Vec<u64>,
-    /// Occupied cells before each word of `occupancy`.
-    rank: Vec<u32>,
-    /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes `blocks`.
-    offsets: Vec<u32>,
+    /// Which cells hold triangles, and where their blocks lie.
+    cells: CellIndex,
     /// The triangles of every occupied cell, eight to a block, cell after cell.
     blocks: Vec<Block>,
     /// Triangle references in `blocks` (lanes in use).
     references: usize,
-    /// Macrocells per axis.
-    macro_resolution: UVec3,
-    /// One bit per macrocell: set when any of its cells holds a triangle.
-    macro_occupancy: Vec<u64>,
     /// Triangles given to the build, degenerate ones included.
     triangle_count: usize,
     /// Triangles that went into cells (the non-degenerate ones).
@@ -111,7 +99,7 @@ impl Grid {
     /// Figures that describe this grid.
     pub fn stats(&self) -> GridStats {
         let cells = self.cell_count();
-        let occupied = self.offsets.len() - 1;
+        let occupied = self.cells.occupied();
         GridStats {
             resolution: self.frame.resolution,
             cells,
@@ -119,70 +107,21 @@ impl Grid {
             references: self.references,
             empty_fraction: 1.0 - occupied as f64 / cells as f64,
             bytes: std::mem::size_of::<Grid>()
-                + std::mem::size_of_val(self.occupancy.as_slice())
-                + std::mem::size_of_val(self.rank.as_slice())
-                + std::mem::size_of_val(self.offsets.as_slice())
-                + std::mem::size_of_val(self.blocks.as_slice())
-                + std::mem::size_of_val(self.macro_occupancy.as_slice()),
+                + self.cells.bytes()
+                + std::mem::size_of_val(self.blocks.as_slice()),
         }
     }
 
+    /// Where cell `c` is counted in storage order.
     #[inline]
-    fn cell_index(&self, c: UVec3) -> usize {
-        self.frame.cell_index(c)
-    }
-
-    /// Where the blocks of cell `index` lie in `blocks`; `None` for empty cells.
-    #[inline]
-    fn cell_range(&self, index: usize) -> Option<Range<usize>> {
-        let word = self.occupancy[index >> 6];
-        let bit = 1u64 << (index & 63);
-        if word & bit == 0 {
-            return None;
-        }
-        let k = self.rank[index >> 6] as usize + (word & (bit - 1)).count_ones() as usize;
-        Some(self.offsets[k] as usize..self.offsets[k + 1] as usize)
-    }
-
-    /// True when the macrocell holding cell `c` holds a triangle.
-    #[inline]
-    fn macro_occupied(&self, c: IVec3) -> bool {
-        let m = (c >> MACRO_SHIFT).as_uvec3();
-        let index =
-            (m.x + self.macro_resolution.x * (m.y + self.macro_resolution.y * m.z)) as usize;
-        self.macro_occupancy[index >> 6] & (1 << (index & 63)) != 0
+    fn storage_key(&self, c: UVec3) -> usize {
+        CellIndex::storage_key(CellIndex::macro_resolution_for(self.frame.resolution), c)
     }
 
     /// Checks the structure's invariants; returns a description of the first broken one.
     pub fn validate(&self) -> Result<(), String> {
-        let cells = self.cell_count();
-        if self.occupancy.len() != cells.div_ceil(64) || self.rank.len() != self.occupancy.len() {
-            return Err(format!(
-                "{} occupancy words and {} ranks for {cells} cells",
-                self.occupancy.len(),
-                self.rank.len()
-            ));
-        }
-        let mut occupied = 0u32;
-        for (w, &word) in self.occupancy.iter().enumerate() {
-            if self.rank[w] != occupied {
-                return Err(format!(
-                    "rank of word {w} is {}, expected {occupied}",
-                    self.rank[w]
-                ));
-            }
-            occupied += word.count_ones();
-        }
-        if self.offsets.len() != occupied as usize + 1 {
-            return Err(format!(
-                "{} offsets for {occupied} occupied cells",
-                self.offsets.len()
-            ));
-        }
-        if self.offsets.windows(2).any(|w| w[0] >= w[1]) {
-            return Err("an occupied cell is empty or offsets decrease".into());
-        }
-        if *self.offsets.last().unwrap() as usize != self.blocks.len() {
+        self.cells.validate(self.frame.resolution)?;
+        if self.cells.block_count() != self.blocks.len() {
             return Err("offsets and blocks disagree in length".into());
         }
         if self.blocks.iter().any(|b| b.len() == 0)
@@ -195,14 +134,9 @@ impl Grid {
             for y in 0..self.frame.resolution.y {
                 for x in 0..self.frame.resolution.x {
                     let c = UVec3::new(x, y, z);
-                    let Some(range) = self.cell_range(self.cell_index(c)) else {
+                    let Lookup::Blocks(range) = self.cells.lookup(c.as_ivec3()) else {
                         continue;
                     };
-                    if !self.macro_occupied(c.as_ivec3()) {
-                        return Err(format!(
-                            "cell {c} is occupied but its macrocell is marked empty"
-                        ));
-                    }
                     let lo = self.frame.bounds.min + c.as_vec3() * self.frame.cell_size;
                     let cell = Aabb {
                         min: lo - self.frame.cell_size * 1e-3,

@@ -5,7 +5,8 @@
 
 use glam::IVec3;
 
-use super::{Grid, GridHit, MACRO_SHIFT};
+use super::cells::{Lookup, MACRO_SHIFT};
+use super::{Grid, GridHit};
 use crate::accel::Ray;
 use crate::accel::frame::CellWalk;
 
@@ -152,12 +153,15 @@ impl Grid {
         }
     }
 
-    /// Moves the walk past the empty macrocell holding its current cell, to the first cell of
-    /// the next macrocell along the ray. False when the ray leaves the grid first.
-    fn skip_macrocell(&self, walk: &mut CellWalk, ray: &Ray) -> bool {
+    /// Moves the walk past the empty cube of macrocells around its current cell (of
+    /// Chebyshev radius `distance − 1`), to the first cell beyond it along the ray. False
+    /// when the ray leaves the grid first.
+    fn skip_empty(&self, walk: &mut CellWalk, ray: &Ray, distance: u32) -> bool {
         let res = self.frame.resolution.as_ivec3();
-        let macro_lo = (walk.cell >> MACRO_SHIFT) << MACRO_SHIFT;
-        let macro_hi = (macro_lo + IVec3::splat((1 << MACRO_SHIFT) - 1)).min(res - 1);
+        let reach = distance.max(1) as i32 - 1;
+        let macrocell = walk.cell >> MACRO_SHIFT;
+        let macro_lo = ((macrocell - reach) << MACRO_SHIFT).max(IVec3::ZERO);
+        let macro_hi = (((macrocell + reach + 1) << MACRO_SHIFT) - 1).min(res - 1);
         let mut axis = 0;
         let mut t_exit = f32::INFINITY;
         for a in 0..3 {
@@ -183,7 +187,7 @@ impl Grid {
         if next < 0 || next >= res[axis] {
             return false;
         }
-        // The other axes: the cell under the exit point, kept within the macrocell and never
+        // The other axes: the cell under the exit point, kept within the empty cube and never
         // behind the current cell, so rounding cannot move the walk backwards or sideways.
         let p = ray.at(t_exit);
         for a in 0..3 {
@@ -222,15 +226,18 @@ impl OccupiedCells<'_> {
         let walk = self.walk.as_mut()?;
         loop {
             stats.visit_cell();
-            if !grid.macro_occupied(walk.cell) {
-                if !grid.skip_macrocell(walk, self.ray) {
-                    self.walk = None;
-                    return None;
+            let range = match grid.cells.lookup(walk.cell) {
+                Lookup::EmptyMacrocell { distance } => {
+                    if !grid.skip_empty(walk, self.ray, distance) {
+                        self.walk = None;
+                        return None;
+                    }
+                    continue;
                 }
-                continue;
-            }
+                Lookup::EmptyCell => None,
+                Lookup::Blocks(range) => Some(range),
+            };
             let exit = walk.exit();
-            let range = grid.cell_range(grid.cell_index(walk.cell.as_uvec3()));
             if exit.last {
                 self.walk = None;
                 return range.map(|r| (r, exit.t));
