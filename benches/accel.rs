@@ -1,23 +1,43 @@
-//! The grid against Embree 4 (`rtcIntersect1`) and the obvhs CWBVH on the full Stanford
-//! dragon: build time, memory, and single-ray throughput on one thread and on all threads,
-//! for rays from outside and for bounce rays, with the ratios measured in the same run.
+//! The grid against Embree 4 (`rtcIntersect1`/`rtcOccluded1`) and the obvhs CWBVH on the
+//! Stanford dragon at several sizes: build time (median of 5), memory per triangle (each
+//! structure's own allocation: Embree's memory monitor, obvhs' node and index arrays, the
+//! grid's arrays), and single-thread throughput on four ray sets — rays from outside, a
+//! pinhole camera's rays, bounce rays from the surface, and shadow segments (`occluded`).
+//!
+//! Timing: each set is cut into chunks of 10,000 rays; for every chunk the three structures
+//! take turns (in rotating order), each keeping the best of 7 repeats, so drifts of the
+//! machine's speed touch all three alike. That is one run; the ratios are reported as the
+//! median and the range over 5 runs. Then the grid's own counters per ray, and its speed-up
+//! on all threads.
 //!
 //! Run with `cargo bench --bench accel` after `tools/setup-dev.sh`. Environment:
-//! `ACCEL_BENCH_RAYS` (rays per set, default 1,000,000) and `ACCEL_BENCH_MODEL` (a file name
-//! from data/dragon, default the full dragon).
+//! `ACCEL_BENCH_MODELS` (comma-separated files of data/dragon, default the smallest, a
+//! middle one and the full dragon), `ACCEL_BENCH_RAYS` (rays per set, default 100,000),
+//! `ACCEL_BENCH_RUNS` (default 5), `ACCEL_BENCH_DENSITY` (the grid's cells per triangle).
 
 #[path = "../tests/oracles/mod.rs"]
 mod oracles;
 
 use std::time::{Duration, Instant};
 
+use glam::Vec3;
 use gridtrace::accel::{Grid, Ray, TraversalCounts};
 use gridtrace::load::ply;
 use gridtrace::scene::Aabb;
 use oracles::embree::Embree;
-use oracles::rays::{bounce_rays, outside_rays};
+use oracles::rays::{bounce_rays, outside_rays, segments};
 use oracles::{Mesh, Obvhs, dragon_path};
 use rayon::prelude::*;
+
+const CHUNK: usize = 10_000;
+const REPEATS: usize = 7;
+
+fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
 
 fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration) {
     let start = Instant::now();
@@ -25,123 +45,191 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration) {
     (value, start.elapsed())
 }
 
-/// Mrays/s of `query` over `rays`: best of three runs, on one thread or on all.
-fn throughput(rays: &[Ray], parallel: bool, query: &(dyn Fn(&Ray) -> bool + Sync)) -> (f64, usize) {
-    let mut best = Duration::MAX;
-    let mut hits = 0;
-    for _ in 0..3 {
-        let (h, t) = timed(|| {
-            if parallel {
-                rays.par_chunks(4096)
-                    .map(|c| c.iter().filter(|r| query(r)).count())
-                    .sum()
-            } else {
-                rays.iter().filter(|r| query(r)).count()
-            }
-        });
-        best = best.min(t);
-        hits = h;
+/// Median and range of a few figures.
+fn summary(mut values: Vec<f64>) -> (f64, f64, f64) {
+    values.sort_by(f64::total_cmp);
+    (
+        values[values.len() / 2],
+        values[0],
+        values[values.len() - 1],
+    )
+}
+
+/// A pinhole camera's rays: from one point framing the box, through a square image.
+fn camera_rays(bounds: &Aabb, count: usize) -> Vec<Ray> {
+    let center = bounds.center();
+    let radius = 0.5 * bounds.extent().length();
+    let eye = center + Vec3::new(0.6, 0.4, 1.0).normalize() * 2.6 * radius;
+    let forward = (center - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let side = (count as f32).sqrt().ceil() as usize;
+    (0..count)
+        .map(|i| {
+            let x = ((i % side) as f32 + 0.5) / side as f32 * 2.0 - 1.0;
+            let y = ((i / side) as f32 + 0.5) / side as f32 * 2.0 - 1.0;
+            let direction = forward + 0.42 * (x * right + y * up);
+            Ray::new(eye, direction.normalize())
+        })
+        .collect()
+}
+
+type Query<'a> = Box<dyn Fn(&Ray) -> bool + 'a>;
+
+/// One run over a ray set: Mrays/s of each query, interleaved chunk by chunk.
+fn run_once(rays: &[Ray], queries: &[Query], run: usize) -> Vec<f64> {
+    let mut total = vec![Duration::ZERO; queries.len()];
+    for (c, chunk) in rays.chunks(CHUNK).enumerate() {
+        for k in 0..queries.len() {
+            let q = (k + c + run) % queries.len();
+            let best = (0..REPEATS)
+                .map(|_| {
+                    let (hits, t) = timed(|| chunk.iter().filter(|r| queries[q](r)).count());
+                    std::hint::black_box(hits);
+                    t
+                })
+                .min()
+                .unwrap();
+            total[q] += best;
+        }
     }
-    (rays.len() as f64 / best.as_secs_f64() / 1e6, hits)
+    total
+        .iter()
+        .map(|t| rays.len() as f64 / t.as_secs_f64() / 1e6)
+        .collect()
 }
 
 fn main() {
-    let count: usize = std::env::var("ACCEL_BENCH_RAYS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1_000_000);
-    let model = std::env::var("ACCEL_BENCH_MODEL").unwrap_or_else(|_| "dragon_vrip.ply.gz".into());
-    let threads = rayon::current_num_threads();
-    let ((positions, indices), load) =
-        timed(|| ply::read_mesh(&dragon_path(&model)).expect("read the dragon"));
-    let mesh = Mesh { positions, indices };
-    let n = mesh.indices.len();
-    println!(
-        "{model}: {n} triangles, {} vertices (read in {:.2} s); {count} rays per set; {threads} threads",
-        mesh.positions.len(),
-        load.as_secs_f64()
+    let models: String = env_or(
+        "ACCEL_BENCH_MODELS",
+        "dragon_vrip_res4.ply.gz,dragon_vrip_res2.ply.gz,dragon_vrip.ply.gz".to_string(),
     );
+    let count: usize = env_or("ACCEL_BENCH_RAYS", 100_000);
+    let runs: usize = env_or("ACCEL_BENCH_RUNS", 5);
+    let density: f32 = env_or(
+        "ACCEL_BENCH_DENSITY",
+        gridtrace::accel::grid::DEFAULT_DENSITY,
+    );
+    println!(
+        "{count} rays per set, {runs} runs, chunks of {CHUNK} rays, best of {REPEATS} per chunk; {} threads for the scaling figure\n",
+        rayon::current_num_threads()
+    );
+    println!(
+        "| model | triangles | rays | grid Mrays/s | Embree | CWBVH | grid/Embree median (range) | grid/CWBVH median (range) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    let mut notes = Vec::new();
+    for model in models.split(',') {
+        let (positions, indices) = ply::read_mesh(&dragon_path(model)).expect("read the dragon");
+        let mesh = Mesh { positions, indices };
+        let n = mesh.indices.len();
+        let triangles = mesh.triangles();
+        // Builds, median of 5 (the builds use all threads, as the renderer's do).
+        let build = |f: &dyn Fn()| {
+            let times = (0..5).map(|_| timed(f).1.as_secs_f64()).collect();
+            summary(times).0
+        };
+        let grid_build = build(&|| {
+            drop(Grid::from_mesh_with_density(
+                mesh.positions.clone(),
+                &mesh.indices,
+                density,
+            ))
+        });
+        let embree_build = build(&|| drop(Embree::build(&mesh)));
+        let bvh_build = build(&|| drop(Obvhs::build(&mesh)));
+        let grid = Grid::from_mesh_with_density(mesh.positions.clone(), &mesh.indices, density);
+        let embree = Embree::build(&mesh);
+        let bvh = Obvhs::build(&mesh);
+        let stats = grid.stats();
+        notes.push(format!(
+            "{model}: build s grid {grid_build:.3}, Embree {embree_build:.3}, CWBVH {bvh_build:.3}; bytes/triangle grid {:.1}, Embree {:.1}, CWBVH {:.1}; grid {}x{}x{} cells, {:.2} references/triangle",
+            stats.bytes as f64 / n as f64,
+            embree.bytes as f64 / n as f64,
+            bvh.bytes() as f64 / n as f64,
+            stats.resolution.x,
+            stats.resolution.y,
+            stats.resolution.z,
+            stats.references as f64 / stats.triangles as f64,
+        ));
 
-    let triangles = mesh.triangles();
-    let density: f32 = std::env::var("ACCEL_BENCH_DENSITY")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(gridtrace::accel::grid::DEFAULT_DENSITY);
-    let (grid, grid_build) =
-        timed(|| Grid::from_mesh_with_density(mesh.positions.clone(), &mesh.indices, density));
-    let (embree, embree_build) = timed(|| Embree::build(&mesh));
-    let (bvh, bvh_build) = timed(|| Obvhs::build(&mesh));
-
-    let stats = grid.stats();
-    println!();
-    println!("| structure | build (s) | bytes/triangle |");
-    println!("|---|---|---|");
-    println!(
-        "| grid | {:.3} | {:.1} |",
-        grid_build.as_secs_f64(),
-        stats.bytes as f64 / n as f64
-    );
-    println!(
-        "| Embree 4 | {:.3} | {:.1} |",
-        embree_build.as_secs_f64(),
-        embree.bytes as f64 / n as f64
-    );
-    println!(
-        "| obvhs CWBVH | {:.3} | {:.1} |",
-        bvh_build.as_secs_f64(),
-        bvh.bytes() as f64 / n as f64
-    );
-    println!(
-        "\ngrid: resolution {}x{}x{} = {} cells, {:.2} references/triangle, {:.1} % empty cells",
-        stats.resolution.x,
-        stats.resolution.y,
-        stats.resolution.z,
-        stats.cells,
-        stats.references as f64 / stats.triangles as f64,
-        100.0 * stats.empty_fraction
-    );
-
-    let bounds = Aabb::from_points(mesh.positions.iter().copied());
-    let sets = [
-        ("outside", outside_rays(&bounds, count, 21)),
-        ("bounce", bounce_rays(&triangles, count, 22)),
-    ];
-    println!();
-    println!(
-        "| rays | threads | grid Mrays/s | Embree Mrays/s | CWBVH Mrays/s | grid/Embree | grid/CWBVH |"
-    );
-    println!("|---|---|---|---|---|---|---|");
-    let mut counts_lines = Vec::new();
-    for (name, rays) in &sets {
-        for parallel in [false, true] {
-            let (g, gh) = throughput(rays, parallel, &|r| grid.intersect(r).is_some());
-            let (e, eh) = throughput(rays, parallel, &|r| embree.intersect(r).is_some());
-            let (b, bh) = throughput(rays, parallel, &|r| bvh.intersect(r).is_some());
-            if !parallel {
-                // Hit counts may differ by a few edge grazes; tests/accel_cross_check.rs says why.
-                counts_lines.push(format!(
-                    "{name} rays hit: grid {gh}, Embree {eh}, CWBVH {bh}"
+        let bounds = Aabb::from_points(mesh.positions.iter().copied());
+        let bounce = bounce_rays(&triangles, count, 22);
+        let shadow = segments(&bounce, 0.3 * bounds.extent().length(), 23);
+        let sets: [(&str, Vec<Ray>, bool); 4] = [
+            ("outside", outside_rays(&bounds, count, 21), false),
+            ("camera", camera_rays(&bounds, count), false),
+            ("bounce", bounce, false),
+            ("shadow", shadow, true),
+        ];
+        for (name, rays, occlusion) in &sets {
+            let queries: Vec<Query> = if *occlusion {
+                vec![
+                    Box::new(|r: &Ray| grid.occluded(r)),
+                    Box::new(|r: &Ray| embree.occluded(r)),
+                    Box::new(|r: &Ray| bvh.occluded(r)),
+                ]
+            } else {
+                vec![
+                    Box::new(|r: &Ray| grid.intersect(r).is_some()),
+                    Box::new(|r: &Ray| embree.intersect(r).is_some()),
+                    Box::new(|r: &Ray| bvh.intersect(r).is_some()),
+                ]
+            };
+            // Queries run on this thread alone: single-thread figures.
+            let rates: Vec<Vec<f64>> = (0..runs).map(|run| run_once(rays, &queries, run)).collect();
+            let (g, _, _) = summary(rates.iter().map(|r| r[0]).collect());
+            let (e, _, _) = summary(rates.iter().map(|r| r[1]).collect());
+            let (b, _, _) = summary(rates.iter().map(|r| r[2]).collect());
+            let (ge, ge_lo, ge_hi) = summary(rates.iter().map(|r| r[0] / r[1]).collect());
+            let (gb, gb_lo, gb_hi) = summary(rates.iter().map(|r| r[0] / r[2]).collect());
+            println!(
+                "| {model} | {n} | {name} | {g:.3} | {e:.3} | {b:.3} | {ge:.2} ({ge_lo:.2}–{ge_hi:.2}) | {gb:.2} ({gb_lo:.2}–{gb_hi:.2}) |"
+            );
+            if !*occlusion {
+                let mut counts = TraversalCounts::default();
+                let mut hits = 0usize;
+                for r in rays {
+                    hits += usize::from(grid.intersect_counting(r, &mut counts).is_some());
+                }
+                let per_ray = |x: u64| x as f64 / rays.len() as f64;
+                notes.push(format!(
+                    "{model}, {name} rays: {:.1} cells stepped, {:.1} occupied cells visited, {:.1} triangle tests, {:.2} hits per ray",
+                    per_ray(counts.cells),
+                    per_ray(counts.occupied),
+                    per_ray(counts.tests),
+                    hits as f64 / rays.len() as f64
                 ));
             }
-            println!(
-                "| {name} | {} | {g:.3} | {e:.3} | {b:.3} | {:.2} | {:.2} |",
-                if parallel { threads } else { 1 },
-                g / e,
-                g / b
-            );
         }
-        let mut counts = TraversalCounts::default();
-        for r in rays {
-            grid.intersect_counting(r, &mut counts);
-        }
-        counts_lines.push(format!(
-            "grid, {name} rays: {:.1} cells visited and {:.1} triangle tests per ray",
-            counts.cells as f64 / rays.len() as f64,
-            counts.tests as f64 / rays.len() as f64
+        // Scaling of the grid over all threads, best of 3.
+        let rays = &sets[2].1;
+        let speed = |parallel: bool| {
+            (0..3)
+                .map(|_| {
+                    timed(|| {
+                        if parallel {
+                            rays.par_chunks(4096)
+                                .map(|c| c.iter().filter(|r| grid.intersect(r).is_some()).count())
+                                .sum::<usize>()
+                        } else {
+                            rays.iter().filter(|r| grid.intersect(r).is_some()).count()
+                        }
+                    })
+                    .1
+                })
+                .min()
+                .unwrap()
+        };
+        let (one, all) = (speed(false), speed(true));
+        notes.push(format!(
+            "{model}: grid on bounce rays, {} threads / 1 thread: {:.2}×",
+            rayon::current_num_threads(),
+            one.as_secs_f64() / all.as_secs_f64()
         ));
     }
     println!();
-    for line in counts_lines {
-        println!("{line}");
+    for note in notes {
+        println!("{note}");
     }
 }

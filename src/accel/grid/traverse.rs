@@ -13,8 +13,10 @@ use crate::accel::frame::CellWalk;
 /// Counts the work a traversal does, for the benchmark's statistics. The unit type counts
 /// nothing and compiles away.
 pub trait TraversalStats {
-    /// One cell (or one skipped macrocell) stepped through.
+    /// One cell (or one skipped stretch of empty macrocells) stepped through.
     fn visit_cell(&mut self) {}
+    /// One occupied cell reached (its triangles are then tested).
+    fn visit_occupied(&mut self) {}
     /// Ray–triangle tests (the triangles of one block, tested together).
     fn test_triangles(&mut self, _count: usize) {}
     /// One instance considered by the top level (its bounding box tested, and its grid
@@ -27,8 +29,10 @@ impl TraversalStats for () {}
 /// Cells visited and triangles tested, summed over rays.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TraversalCounts {
-    /// Cells and skipped macrocells stepped through.
+    /// Cells and skipped stretches of empty macrocells stepped through.
     pub cells: u64,
+    /// Occupied cells reached.
+    pub occupied: u64,
     /// Ray–triangle tests.
     pub tests: u64,
     /// Instances considered by the top level.
@@ -38,6 +42,9 @@ pub struct TraversalCounts {
 impl TraversalStats for TraversalCounts {
     fn visit_cell(&mut self) {
         self.cells += 1;
+    }
+    fn visit_occupied(&mut self) {
+        self.occupied += 1;
     }
     fn test_triangles(&mut self, count: usize) {
         self.tests += count as u64;
@@ -235,7 +242,10 @@ impl OccupiedCells<'_> {
                     continue;
                 }
                 Lookup::EmptyCell => None,
-                Lookup::Blocks(range) => Some(range),
+                Lookup::Blocks(range) => {
+                    stats.visit_occupied();
+                    Some(range)
+                }
             };
             let exit = walk.exit();
             if exit.last {
