@@ -34,6 +34,17 @@ pub(super) struct LaneHit {
     pub id: u32,
 }
 
+impl From<LaneHit> for super::GridHit {
+    fn from(hit: LaneHit) -> super::GridHit {
+        super::GridHit {
+            t: hit.t,
+            u: hit.u,
+            v: hit.v,
+            triangle: hit.id,
+        }
+    }
+}
+
 impl Block {
     /// A block of unused lanes.
     pub const EMPTY: Block = Block {

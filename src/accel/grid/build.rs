@@ -11,6 +11,9 @@ use crate::accel::Triangle;
 use crate::accel::frame::{GridFrame, padded, resolution};
 use crate::scene::Aabb;
 
+/// Meshes of at most this many triangles (two blocks) get a single cell: a wall, a box.
+pub(super) const SINGLE_CELL_MAX: usize = 2 * LANES;
+
 /// Bounding boxes of at most this many cells are tested cell by cell; larger ones are
 /// walked slab by slab (clipping costs more than it saves on a few cells).
 const SMALL_BOX_CELLS: u64 = 64;
@@ -69,7 +72,12 @@ impl Grid {
             )
         } else {
             let bounds = padded(tight);
-            let wanted = resolution(bounds.extent(), live.len(), density);
+            // A few triangles are tested faster all at once than found by walking cells.
+            let wanted = if live.len() <= SINGLE_CELL_MAX {
+                UVec3::ONE
+            } else {
+                resolution(bounds.extent(), live.len(), density)
+            };
             let live_triangles: Vec<Triangle> = live
                 .iter()
                 .map(|&i| triangles[i as usize].unwrap())

@@ -3,7 +3,7 @@
 //! (so empty cells never touch the offset array) and one per macrocell of
 //! `MACRO_CELLS`³ cells, which the walk crosses in a single step when it is empty.
 
-use glam::IVec3;
+use glam::{IVec3, UVec3};
 
 use super::cells::{Lookup, MACRO_SHIFT};
 use super::{Grid, GridHit};
@@ -88,18 +88,24 @@ impl Grid {
         // within the cell being visited, since every later cell lies beyond that cell.
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
+        if self.frame.resolution == UVec3::ONE {
+            // One cell: no walk, every hit counts.
+            for block in &self.blocks {
+                stats.test_triangles(block.len());
+                if let Some(hit) = block.nearest(ray, t_nearest) {
+                    t_nearest = hit.t;
+                    nearest = Some(hit.into());
+                }
+            }
+            return nearest;
+        }
         let mut cells = self.occupied_cells(ray);
         while let Some((range, limit)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
                 if let Some(hit) = block.nearest(ray, t_nearest) {
                     t_nearest = hit.t;
-                    nearest = Some(GridHit {
-                        t: hit.t,
-                        u: hit.u,
-                        v: hit.v,
-                        triangle: hit.id,
-                    });
+                    nearest = Some(hit.into());
                 }
             }
             if t_nearest <= limit {
@@ -133,6 +139,12 @@ impl Grid {
 
     #[inline(always)]
     fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        if self.frame.resolution == UVec3::ONE {
+            return self.blocks.iter().any(|block| {
+                stats.test_triangles(block.len());
+                block.any(ray, ray.t_max)
+            });
+        }
         let mut cells = self.occupied_cells(ray);
         while let Some((range, _)) = cells.next(stats) {
             for block in &self.blocks[range] {
