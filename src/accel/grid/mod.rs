@@ -1,4 +1,5 @@
-//! A uniform grid over one mesh's triangles, in object space.
+//! A uniform grid over one mesh's triangles, in object space (or in world space, for a mesh
+//! placed once).
 //!
 //! Triangles go only into the cells they really overlap (triangle–box separating-axis
 //! test). Storage is compact (after Lagae & Dutré 2008): offsets for occupied cells only,
