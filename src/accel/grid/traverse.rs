@@ -1,7 +1,8 @@
 //! Ray traversal: the 3D-DDA of Amanatides & Woo (1987), "A fast voxel traversal algorithm
-//! for ray tracing", with two levels of empty-space skipping: an occupancy bit per cell
-//! (so empty cells never touch the offset array) and one per macrocell of
-//! `MACRO_CELLS`³ cells, which the walk crosses in a single step when it is empty.
+//! for ray tracing", over the two-level cell index ([`super::cells`]): an empty macrocell
+//! sends the walk past the whole empty cube around it in one step, an empty cell costs a
+//! bit test, and an occupied cell's blocks are tested eight triangles at a time. A grid of
+//! one cell is not walked: its blocks are tested at once.
 
 use glam::{IVec3, UVec3};
 
@@ -88,17 +89,6 @@ impl Grid {
         // within the cell being visited, since every later cell lies beyond that cell.
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
-        if self.frame.resolution == UVec3::ONE {
-            // One cell: no walk, every hit counts.
-            for block in &self.blocks {
-                stats.test_triangles(block.len());
-                if let Some(hit) = block.nearest(ray, t_nearest) {
-                    t_nearest = hit.t;
-                    nearest = Some(hit.into());
-                }
-            }
-            return nearest;
-        }
         let mut cells = self.occupied_cells(ray);
         while let Some((range, limit)) = cells.next(stats) {
             for block in &self.blocks[range] {
@@ -139,12 +129,6 @@ impl Grid {
 
     #[inline(always)]
     fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        if self.frame.resolution == UVec3::ONE {
-            return self.blocks.iter().any(|block| {
-                stats.test_triangles(block.len());
-                block.any(ray, ray.t_max)
-            });
-        }
         let mut cells = self.occupied_cells(ray);
         while let Some((range, _)) = cells.next(stats) {
             for block in &self.blocks[range] {
@@ -160,7 +144,8 @@ impl Grid {
     /// The occupied cells along `ray`, front to back.
     #[inline(always)]
     fn occupied_cells<'a>(&'a self, ray: &'a Ray) -> OccupiedCells<'a> {
-        let walk = if self.blocks.is_empty() {
+        let single_cell = self.frame.resolution == UVec3::ONE;
+        let walk = if self.blocks.is_empty() || single_cell {
             None
         } else {
             self.frame.start_walk(ray)
@@ -169,6 +154,7 @@ impl Grid {
             grid: self,
             ray,
             walk,
+            single_cell: single_cell && !self.blocks.is_empty(),
         }
     }
 
@@ -234,6 +220,9 @@ struct OccupiedCells<'a> {
     ray: &'a Ray,
     /// `None` once the ray has left the grid.
     walk: Option<CellWalk>,
+    /// True until the one cell of a single-cell grid has been given out: such a grid is not
+    /// walked (a few triangles are tested faster all at once than found by a walk).
+    single_cell: bool,
 }
 
 impl OccupiedCells<'_> {
@@ -242,6 +231,11 @@ impl OccupiedCells<'_> {
     #[inline(always)]
     fn next(&mut self, stats: &mut impl TraversalStats) -> Option<(std::ops::Range<usize>, f32)> {
         let grid = self.grid;
+        if self.single_cell {
+            self.single_cell = false;
+            // Every hit belongs to the one cell.
+            return Some((0..grid.blocks.len(), f32::INFINITY));
+        }
         let walk = self.walk.as_mut()?;
         loop {
             stats.visit_cell();
