@@ -17,9 +17,10 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 
 use crate::limits::check_memory;
-use crate::output::{read_exr_header, read_exr_rgba};
+use crate::output::{read_exr_header, read_exr_pixels};
 use crate::record::{RECORD_ATTRIBUTE, RecordError, RenderRecord, format_range};
-use crate::render::{Image, PixelAccumulator};
+use crate::render::aov::FeatureAccumulator;
+use crate::render::{AovImage, Image, PixelAccumulator};
 
 /// Largest relative difference between a merged pixel and the single render's: 2^-22.
 pub const MERGE_TOLERANCE: f32 = 1.0 / (1u32 << 22) as f32;
@@ -36,8 +37,11 @@ const MAX_COMPRESSION_RATIO: u64 = 2048;
 /// Bytes of RGBA f32 pixel data per pixel in a part.
 const PART_BYTES_PER_PIXEL: u64 = 16;
 
-/// Memory a merge holds per pixel: the accumulators, one part's pixels and the result.
-const MERGE_BYTES_PER_PIXEL: u64 = std::mem::size_of::<PixelAccumulator>() as u64 + 2 * 16;
+/// Memory a merge holds per pixel: the accumulators, one part's pixels and the result,
+/// with all their layers.
+const MERGE_BYTES_PER_PIXEL: u64 = std::mem::size_of::<PixelAccumulator>() as u64
+    + std::mem::size_of::<FeatureAccumulator>() as u64
+    + 2 * 4 * 21;
 
 /// One rendered part as its header describes it; the pixels are read when needed
 /// ([`Part::read_image`]), so a merge holds one part's pixels at a time.
@@ -116,6 +120,16 @@ pub enum MergeError {
         second_samples: Range<u32>,
         /// The samples both hold.
         overlap: Range<u32>,
+    },
+    /// An adaptive render's pixels hold different sample counts: not a part.
+    #[error(
+        "{}: rendered with --noise-threshold, so its pixels hold different numbers of samples \
+         and it cannot be merged (split renders use a fixed --spp)",
+        path.display()
+    )]
+    Adaptive {
+        /// The part.
+        path: PathBuf,
     },
     /// The parts leave samples out between them.
     #[error(
@@ -200,13 +214,16 @@ impl Part {
     /// Reads the pixels: the mean radiance and alpha of the part's samples, checked to be
     /// values a render makes.
     pub fn read_image(&self) -> Result<Image, MergeError> {
-        let (pixels, alpha) =
-            read_exr_rgba(&self.path).map_err(|message| MergeError::Unreadable {
-                path: self.path.clone(),
-                message,
-            })?;
+        let read = read_exr_pixels(&self.path).map_err(|message| MergeError::Unreadable {
+            path: self.path.clone(),
+            message,
+        })?;
+        let mut aovs = read.aovs;
+        // A denoised part merges by the samples it holds: its noisy beauty.
+        let (pixels, alpha) = aovs.noisy.take().unwrap_or((read.rgb, read.alpha));
         let (width, height) = (self.record.identity.width, self.record.identity.height);
-        if pixels.len() != width as usize * height as usize {
+        let n = width as usize * height as usize;
+        if pixels.len() != n || alpha.len() != n {
             return Err(self.damaged(format!(
                 "{} pixels where the header says {width}x{height}",
                 pixels.len()
@@ -225,6 +242,21 @@ impl Part {
                 alpha[i]
             )));
         }
+        if aovs.set().label() != self.record.identity.aovs {
+            return Err(self.damaged(format!(
+                "its layers are '{}' but its record says '{}'",
+                aovs.set().label(),
+                self.record.identity.aovs
+            )));
+        }
+        if let Some(i) = (0..n).find(|&i| !is_feature_value(&aovs, i)) {
+            return Err(self.damaged(format!(
+                "pixel ({}, {}) of a layer holds {:?}, which no render makes",
+                i % width as usize,
+                i / width as usize,
+                aovs.pixel(i)
+            )));
+        }
         let samples = &self.record.samples;
         Ok(Image {
             width,
@@ -233,6 +265,8 @@ impl Part {
             alpha,
             spp: samples.end - samples.start,
             first_sample: samples.start,
+            aovs,
+            pixel_samples: read.pixel_samples,
         })
     }
 
@@ -247,6 +281,16 @@ impl Part {
 /// Radiance is finite and never negative; alpha is a fraction.
 fn is_rendered_value(radiance: Vec3, alpha: f32) -> bool {
     radiance.is_finite() && radiance.min_element() >= 0.0 && (0.0..=1.0).contains(&alpha)
+}
+
+/// Layer values are finite, coverage a fraction, variance never negative.
+fn is_feature_value(aovs: &AovImage, i: usize) -> bool {
+    let p = aovs.pixel(i);
+    let finite = [p.albedo, p.normal, p.position, p.variance]
+        .iter()
+        .all(|v| v.is_finite())
+        && p.depth.is_finite();
+    finite && (0.0..=1.0).contains(&p.coverage) && p.variance.min_element() >= 0.0
 }
 
 /// Reads the parts at `paths`, checks that they belong to one render and hold disjoint,
@@ -270,6 +314,11 @@ pub fn merge_parts(
     wanted: Option<Range<u32>>,
 ) -> Result<(Image, RenderRecord), MergeError> {
     let first = parts.first().ok_or(MergeError::NoParts)?;
+    if let Some(adaptive) = parts.iter().find(|p| p.record.noise_threshold.is_some()) {
+        return Err(MergeError::Adaptive {
+            path: adaptive.path.clone(),
+        });
+    }
     for part in &parts[1..] {
         if let Some((field, ours, theirs)) = first.record.identity.difference(&part.record.identity)
         {
@@ -317,27 +366,48 @@ pub fn merge_parts(
         (width as u64 * height as u64).saturating_mul(MERGE_BYTES_PER_PIXEL),
     )
     .map_err(MergeError::Memory)?;
-    let mut pixels =
-        vec![PixelAccumulator::default(); identity.width as usize * identity.height as usize];
+    let n = width as usize * height as usize;
+    let mut pixels = vec![PixelAccumulator::default(); n];
+    let mut features = Vec::new();
+    let mut layers = None;
     for part in &order {
         let image = part.read_image()?;
+        let set = image.aovs.set();
+        if set.any() && features.is_empty() {
+            features = vec![FeatureAccumulator::default(); n];
+        }
+        layers = Some(set);
         for (i, acc) in pixels.iter_mut().enumerate() {
             let from = PixelAccumulator::from_mean(image.pixels[i], image.alpha[i], image.spp);
             acc.merge(&from);
+            if let Some(f) = features.get_mut(i) {
+                let aov = image.aovs.pixel(i);
+                f.merge(&FeatureAccumulator::from_means(
+                    &aov,
+                    image.pixels[i],
+                    image.spp,
+                ));
+            }
         }
     }
     let spp = have.end - have.start;
     let mut image = Image::new(identity.width, identity.height);
     image.spp = spp;
     image.first_sample = have.start;
+    image.aovs = AovImage::with_layers(layers.unwrap_or_default(), n);
     for (i, acc) in pixels.iter().enumerate() {
         (image.pixels[i], image.alpha[i]) = acc.resolve(spp);
+        if let Some(f) = features.get(i) {
+            image.aovs.set_pixel(i, &f.resolve(spp, acc.sum()));
+        }
     }
     let record = RenderRecord {
         identity: identity.clone(),
         scene_name: first.record.scene_name.clone(),
         samples: have,
         nonfinite: parts.iter().map(|p| p.record.nonfinite).sum(),
+        noise_threshold: None,
+        denoised: false,
     };
     Ok((image, record))
 }

@@ -28,6 +28,11 @@ pub struct RenderRecord {
     pub samples: Range<u32>,
     /// Samples that came out NaN or infinite and were counted as black.
     pub nonfinite: u64,
+    /// `--noise-threshold` of an adaptive render, whose pixels hold different numbers of
+    /// samples (the `samples.N` layer): such images are not parts that merge.
+    pub noise_threshold: Option<f32>,
+    /// True when the beauty was denoised (the noisy one is the `noisy` layer).
+    pub denoised: bool,
 }
 
 /// Everything that decides which value a given sample of a given pixel takes. Parts with the
@@ -54,6 +59,9 @@ pub struct RenderIdentity {
     pub load_options: String,
     /// `--exposure` in stops, applied to every output: parts merge only at equal exposure.
     pub exposure: f32,
+    /// The auxiliary layers kept (`--aov`), comma-separated: parts merge only with the
+    /// same layers.
+    pub aovs: String,
 }
 
 /// Why a header does not hold a record.
@@ -91,7 +99,7 @@ impl RenderIdentity {
     }
 
     /// The identity as (attribute name, text) pairs, in a fixed order.
-    fn fields(&self) -> [(&'static str, String); 10] {
+    fn fields(&self) -> [(&'static str, String); 11] {
         [
             ("version", self.version.clone()),
             ("sceneSha256", self.scene_sha256.clone()),
@@ -103,6 +111,7 @@ impl RenderIdentity {
             ("maxDepth", self.max_depth.to_string()),
             ("loadOptions", self.load_options.clone()),
             ("exposure", self.exposure.to_string()),
+            ("aovs", self.aovs.clone()),
         ]
     }
 }
@@ -115,6 +124,12 @@ impl RenderRecord {
         fields.push(("scene", self.scene_name.clone()));
         fields.push(("samples", format_range(&self.samples)));
         fields.push(("nonfinite", self.nonfinite.to_string()));
+        if let Some(t) = self.noise_threshold {
+            fields.push(("noiseThreshold", t.to_string()));
+        }
+        if self.denoised {
+            fields.push(("denoised", "true".into()));
+        }
         fields
             .into_iter()
             .map(|(k, v)| format!("{k}={}\n", escape(&v)))
@@ -180,10 +195,23 @@ impl RenderRecord {
                         },
                     )?,
                 },
+                // Records from before --aov had no layers.
+                aovs: text("aovs").unwrap_or_default(),
             },
             scene_name: text("scene")?,
             samples,
             nonfinite: number("nonfinite")?,
+            noise_threshold: match text("noiseThreshold") {
+                Err(_) => None,
+                Ok(value) => Some(value.parse::<f32>().ok().filter(|v| *v > 0.0).ok_or(
+                    RecordError::Malformed {
+                        key: "noiseThreshold",
+                        value,
+                        expected: "a positive number",
+                    },
+                )?),
+            },
+            denoised: text("denoised").is_ok_and(|v| v == "true"),
         })
     }
 }
@@ -317,10 +345,13 @@ mod tests {
                 max_depth: 16,
                 load_options: "gltf-light-units=standard".into(),
                 exposure: -1.5,
+                aovs: "albedo,normal".into(),
             },
             scene_name: "box.glb".into(),
             samples: 64..128,
             nonfinite: 2,
+            noise_threshold: None,
+            denoised: false,
         }
     }
 
@@ -328,8 +359,12 @@ mod tests {
     fn a_record_survives_its_text() {
         let record = record();
         let text = record.to_text();
-        assert_eq!(text.lines().count(), 13, "one line per field:\n{text}");
+        assert_eq!(text.lines().count(), 14, "one line per field:\n{text}");
         assert_eq!(RenderRecord::from_text(&text), Ok(record.clone()));
+        let mut adaptive = record.clone();
+        adaptive.noise_threshold = Some(0.02);
+        adaptive.denoised = true;
+        assert_eq!(RenderRecord::from_text(&adaptive.to_text()), Ok(adaptive));
         // Records from before --exposure read as 0 stops.
         let old: String = text
             .lines()

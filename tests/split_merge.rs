@@ -37,10 +37,13 @@ fn record(samples: Range<u32>, seed: u64) -> RenderRecord {
             max_depth: 8,
             load_options: String::new(),
             exposure: 0.0,
+            aovs: String::new(),
         },
         scene_name: "cornell_box.glb".into(),
         samples,
         nonfinite: 0,
+        noise_threshold: None,
+        denoised: false,
     }
 }
 

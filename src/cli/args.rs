@@ -11,7 +11,7 @@ use crate::limits::parse_size;
 use crate::load::GltfLightUnits;
 use crate::output::ViewTransform;
 use crate::record::parse_range;
-use crate::render::FilterKind;
+use crate::render::{AovSet, FilterKind};
 
 /// Render a glTF 2.0 (.gltf, .glb), USD (.usd, .usda, .usdc, .usdz) or PLY scene with a
 /// physically based path tracer.
@@ -45,9 +45,10 @@ pub struct Args {
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
 
-    /// Samples per pixel: more means less noise and a longer render.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
-    pub spp: u32,
+    /// Samples per pixel: more means less noise and a longer render. [default: 64; with
+    /// --time-limit, as many as the time allows]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: Option<u32>,
 
     /// Render only samples A to B−1 of every pixel, as one part of a render split across
     /// processes or machines; `gridtrace merge` combines the parts (write them as .exr).
@@ -207,6 +208,34 @@ pub struct Args {
     /// `gridtrace merge` accepts), so a killed render keeps its samples.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub checkpoint: Option<f64>,
+
+    /// Auxiliary layers written into the EXR beside the beauty, comma-separated: albedo,
+    /// normal (of the first rough surface, through mirrors and glass, as denoisers want),
+    /// depth (path length to it), position, variance (of the radiance samples), or all.
+    #[arg(long, value_name = "LAYERS", value_parser = AovSet::parse)]
+    pub aov: Option<AovSet>,
+
+    /// Denoise the image with Intel Open Image Denoise, guided by the albedo and normal
+    /// layers (kept in the EXR, with the noisy beauty as the `noisy` layer). Needs the OIDN
+    /// 2 library; see the README.
+    #[arg(long)]
+    pub denoise: bool,
+
+    /// Adaptive sampling: a pixel stops once its estimated error (standard error over the
+    /// square root of its intensity, as in Cycles) is below T, after at least max(16, √spp)
+    /// samples. Such renders cannot be split with --samples. [typical: 0.01]
+    #[arg(long, value_name = "T", value_parser = parse_threshold, conflicts_with = "samples")]
+    pub noise_threshold: Option<f32>,
+
+    /// Stop after this many seconds of rendering (no pass is started that would end
+    /// later), writing the samples taken; the image's record says how many.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub time_limit: Option<f64>,
+
+    /// Show the image as it converges in the tev viewer listening at HOST:PORT (tev's
+    /// default is 127.0.0.1:14158). A viewer that goes away does not stop the render.
+    #[arg(long, value_name = "HOST:PORT")]
+    pub display: Option<String>,
 }
 
 /// Commands other than rendering.
@@ -215,6 +244,37 @@ pub enum Command {
     /// Combine EXR parts of one render (rendered with --samples) into one image, equal to
     /// the render of all their samples by one process.
     Merge(MergeArgs),
+    /// Denoise an EXR gridtrace wrote (a merged render, say) with Intel Open Image Denoise,
+    /// using its albedo and normal layers when it has them.
+    Denoise(DenoiseArgs),
+}
+
+/// Arguments of `gridtrace denoise`.
+#[derive(clap::Args, Debug)]
+pub struct DenoiseArgs {
+    /// The image to denoise: an EXR written by gridtrace (render or merge).
+    #[arg(value_name = "IMAGE")]
+    pub input: PathBuf,
+
+    /// The denoised image, .exr (with the noisy beauty as its `noisy` layer) or .png.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+
+    /// Worker threads. [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+
+    /// No summary; errors are still printed.
+    #[arg(short, long)]
+    pub quiet: bool,
+
+    /// Most memory to use; see `gridtrace --help`.
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub max_memory: Option<u64>,
+
+    /// How a PNG output shows the linear image; see `gridtrace --help`.
+    #[arg(long, value_enum, value_name = "VIEW", default_value = "standard")]
+    pub view_transform: ViewTransform,
 }
 
 /// Arguments of `gridtrace merge`.
@@ -240,6 +300,15 @@ pub struct MergeArgs {
     /// Most memory to use; see `gridtrace --help`.
     #[arg(long, value_name = "SIZE", value_parser = parse_size)]
     pub max_memory: Option<u64>,
+
+    /// Denoise the merged image (see `gridtrace --help`); parts rendered with --denoise
+    /// merge by their noisy layers.
+    #[arg(long)]
+    pub denoise: bool,
+
+    /// Worker threads for --denoise. [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
 
     /// How a PNG output shows the linear image; see `gridtrace --help`.
     #[arg(long, value_enum, value_name = "VIEW", default_value = "standard")]
@@ -278,6 +347,15 @@ fn parse_seconds(text: &str) -> Result<f64, String> {
         text,
         |s: f64| s.is_finite() && s > 0.0,
         "a positive number of seconds",
+    )
+}
+
+/// A noise threshold: above 0, at most 1.
+fn parse_threshold(text: &str) -> Result<f32, String> {
+    parse_number(
+        text,
+        |t: f32| t.is_finite() && t > 0.0 && t <= 1.0,
+        "a noise threshold above 0 and at most 1",
     )
 }
 

@@ -5,7 +5,10 @@ mod agx;
 mod exr;
 mod png;
 
-pub use exr::{ExrHeader, read_header as read_exr_header, read_rgba as read_exr_rgba};
+pub use exr::{
+    ExrHeader, ExrPixels, read_header as read_exr_header, read_pixels as read_exr_pixels,
+    read_rgba as read_exr_rgba,
+};
 pub use png::{ViewTransform, display_bytes};
 
 use std::io::Write;

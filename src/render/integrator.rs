@@ -8,6 +8,7 @@
 use glam::Vec3;
 
 use super::Renderer;
+use super::aov::Features;
 use super::bsdf::Bsdf;
 use super::sampler::Sampler;
 use super::sampling::power_heuristic;
@@ -54,18 +55,37 @@ pub struct PathResult {
     pub hit: bool,
     /// Rays traced: closest-hit and shadow.
     pub rays: u64,
+    /// What the path saw at its first rough surface (when asked for).
+    pub features: Features,
 }
 
 impl Renderer<'_> {
     /// Estimates the radiance arriving along `ray` (pointing into the scene).
     pub fn trace_path(
         &self,
-        mut ray: Ray,
+        ray: Ray,
         sampler: &mut Sampler,
         max_depth: u32,
         strategy: Strategy,
     ) -> PathResult {
+        self.trace_path_with_features(ray, sampler, max_depth, strategy, false)
+    }
+
+    /// [`Renderer::trace_path`], also reporting the path's [`Features`] when
+    /// `want_features` (which changes no random number, so not the radiance).
+    pub fn trace_path_with_features(
+        &self,
+        mut ray: Ray,
+        sampler: &mut Sampler,
+        max_depth: u32,
+        strategy: Strategy,
+        want_features: bool,
+    ) -> PathResult {
         let mut result = PathResult::default();
+        // Features still to be found: the path has not reached a rough surface yet.
+        let mut seeking = want_features;
+        // Distance along the path from the camera, for the depth layer.
+        let mut path_length = 0.0f32;
         let mut beta = Vec3::ONE;
         let mut eta_scale = 1.0f32;
         let mut arrival = Arrival::Specular;
@@ -111,6 +131,12 @@ impl Renderer<'_> {
                 if depth == 0 && !self.environment_visible {
                     break;
                 }
+                if seeking {
+                    result.features = Features {
+                        albedo: environment.min(Vec3::ONE),
+                        ..Features::default()
+                    };
+                }
                 if environment != Vec3::ZERO {
                     let weight = emission_weight(arrival, strategy, light_pdf);
                     result.radiance += weight * beta * environment;
@@ -119,6 +145,7 @@ impl Renderer<'_> {
             };
             let segment = hit.t * ray.direction.length();
             travelled += segment;
+            path_length += segment;
             if let Some(sigma) = medium {
                 beta *= (-sigma * segment).exp();
             }
@@ -145,6 +172,24 @@ impl Renderer<'_> {
             let cos_o = s.geometric_normal.dot(wo);
             let front = cos_o > 0.0;
             let shading = self.shade(&s, front);
+            if seeking {
+                // Albedo and normal of every surface on the way, so a path that ends at a
+                // mirror or in glass still reports the last surface it met; a rough
+                // surface ends the search.
+                let n = if shading.normal.dot(wo) < 0.0 {
+                    -shading.normal
+                } else {
+                    shading.normal
+                };
+                result.features = Features {
+                    albedo: shading.base_colour,
+                    normal: n,
+                    position: s.point,
+                    distance: path_length,
+                    surface: true,
+                };
+                seeking = shading.bsdf.is_delta() && !material.unlit;
+            }
             if material.unlit {
                 if matches!(arrival, Arrival::Specular) {
                     result.radiance += beta * shading.base_colour;

@@ -3,9 +3,11 @@
 //! [`Renderer`] holds everything derived from a [`Scene`] once (acceleration structure,
 //! light list, BSDFs); [`Renderer::render`] turns a camera into an [`Image`].
 
+pub mod aov;
 mod bsdf;
 mod camera;
 mod film;
+pub mod adaptive;
 mod filter;
 mod integrator;
 mod lights;
@@ -16,7 +18,8 @@ mod surface;
 
 pub use bsdf::{Bsdf, BsdfSample, fresnel_dielectric};
 pub use camera::RayGenerator;
-pub use film::{Image, PixelAccumulator};
+pub use aov::{AovImage, AovSet, Features};
+pub use film::{Film, Image, PixelAccumulator};
 pub use filter::{FilterKind, PixelFilter, profile as filter_profile};
 pub use integrator::{PathResult, Strategy};
 pub use lights::{LightSample, LightSet};
@@ -56,6 +59,13 @@ pub struct RenderSettings {
     pub filter: FilterKind,
     /// Its width in pixels.
     pub filter_width: f32,
+    /// Auxiliary layers to keep.
+    pub aovs: AovSet,
+    /// Adaptive sampling: pixels stop once their estimated error falls below this
+    /// ([`adaptive`]); `None` samples every pixel `spp` times.
+    pub noise_threshold: Option<f32>,
+    /// Stop starting passes once the next would end after this much time.
+    pub time_limit: Option<Duration>,
 }
 
 impl Default for RenderSettings {
@@ -70,6 +80,9 @@ impl Default for RenderSettings {
             strategy: Strategy::Mis,
             filter: FilterKind::Box,
             filter_width: 1.0,
+            aovs: AovSet::default(),
+            noise_threshold: None,
+            time_limit: None,
         }
     }
 }
@@ -186,17 +199,35 @@ impl<'a> Renderer<'a> {
         let width = settings.width as usize;
         let spp = settings.spp.max(1).min(u32::MAX - settings.first_sample);
         let seed = mix64(settings.seed);
-        let mut pixels = vec![PixelAccumulator::default(); width * settings.height as usize];
+        let adaptive = settings.noise_threshold.map(|t| adaptive::Schedule::new(t, spp));
+        let mut film = Film::new(
+            settings.width,
+            settings.height,
+            settings.first_sample,
+            settings.aovs,
+            adaptive.is_some(),
+        );
         let mut stats = RenderStats::default();
+        let image_so_far = |film: &Film, mut stats: RenderStats| {
+            let (image, nonfinite) = film.resolve(stats.spp);
+            stats.nonfinite = nonfinite;
+            stats.elapsed = start.elapsed();
+            (image, stats)
+        };
         while stats.spp < spp {
+            let pass_start = Instant::now();
             let sample = settings.first_sample + stats.spp;
-            stats.rays += pixels
-                .par_chunks_mut(width)
-                .enumerate()
-                .map(|(y, row)| {
-                    let mut rays = 0u64;
-                    for (x, acc) in row.iter_mut().enumerate() {
-                        let pixel = (y * width + x) as u64;
+            let (rays, samples) = film
+                .rows()
+                .into_par_iter()
+                .map(|mut row| {
+                    let (mut rays, mut samples) = (0u64, 0u64);
+                    let wants_features = row.wants_features();
+                    for x in 0..row.len() {
+                        if !row.is_active(x) {
+                            continue;
+                        }
+                        let pixel = (row.y * width + x) as u64;
                         let mut sampler = Sampler::for_sample(seed, pixel, sample);
                         let at = filter.sample(sampler.uniform2());
                         // A lens position only when there is a lens, so pinhole images keep
@@ -208,55 +239,49 @@ impl<'a> Renderer<'a> {
                         };
                         // A shutter time only when something moves, likewise.
                         let time = if timed { sampler.uniform() } else { 0.0 };
-                        let (px, py) = (x as f32 + at.x, y as f32 + at.y);
+                        let (px, py) = (x as f32 + at.x, row.y as f32 + at.y);
                         let ray = generator.generate_through_lens(px, py, lens, time);
-                        let path = self.trace_path(
+                        let path = self.trace_path_with_features(
                             ray,
                             &mut sampler,
                             settings.max_depth,
                             settings.strategy,
+                            wants_features,
                         );
                         rays += path.rays;
-                        acc.add(path.radiance, path.hit);
+                        samples += 1;
+                        row.add(x, path.radiance, path.hit, &path.features);
                     }
                     on_row();
-                    rays
+                    (rays, samples)
                 })
-                .sum::<u64>();
+                .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+            stats.rays += rays;
+            stats.samples += samples;
             stats.spp += 1;
             if stop.load(Ordering::Relaxed) {
                 break;
             }
+            if let Some(schedule) = &adaptive
+                && schedule.check_after(stats.spp)
+                && film.update_active(|b, f, n| schedule.converged(b, f, n)) == 0
+            {
+                break;
+            }
+            if let Some(limit) = settings.time_limit
+                && start.elapsed() + pass_start.elapsed() > limit
+            {
+                break;
+            }
             if stats.spp < spp {
-                on_pass(&|| resolve(&pixels, settings, stats, start));
+                on_pass(&|| image_so_far(&film, stats));
             }
         }
-        resolve(&pixels, settings, stats, start)
+        image_so_far(&film, stats)
     }
 }
 
-/// The image of the samples in `pixels` so far, and the counters that go with it.
-fn resolve(
-    pixels: &[PixelAccumulator],
-    settings: &RenderSettings,
-    mut stats: RenderStats,
-    start: Instant,
-) -> (Image, RenderStats) {
-    let mut image = Image::new(settings.width, settings.height);
-    image.spp = stats.spp;
-    image.first_sample = settings.first_sample;
-    for (i, acc) in pixels.iter().enumerate() {
-        (image.pixels[i], image.alpha[i]) = acc.resolve(stats.spp);
-        stats.nonfinite += acc.nonfinite as u64;
-    }
-    stats.samples = stats.spp as u64 * pixels.len() as u64;
-    stats.elapsed = start.elapsed();
-    (image, stats)
-}
-
-/// Memory a render of `width`×`height` needs for its film: the accumulators, the image, and
-/// a second image and its encoding while a checkpoint or the output is written.
+/// Memory a render of `width`×`height` needs for its film (see [`Film::bytes`]).
 pub fn film_bytes(width: u32, height: u32) -> u64 {
-    let per_pixel = std::mem::size_of::<PixelAccumulator>() as u64 + 3 * 16;
-    (width as u64 * height as u64).saturating_mul(per_pixel)
+    Film::bytes(width, height, AovSet::default(), false)
 }

@@ -1,0 +1,63 @@
+//! `--denoise` and `gridtrace denoise`: Open Image Denoise on a finished image.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+
+use super::args::DenoiseArgs;
+use super::signals::{Phase, output_lock, set_phase};
+use crate::denoise::denoise;
+use crate::limits::set_memory_budget;
+use crate::merge::read_part;
+use crate::output::{check_writable, write_image_with_record};
+use crate::render::Image;
+
+/// Denoises `image` for writing, saying what guides it unless `quiet`.
+pub fn denoise_for_output(image: &mut Image, threads: Option<u32>, quiet: bool) -> Result<()> {
+    let start = Instant::now();
+    let guides = match (&image.aovs.albedo, &image.aovs.normal) {
+        (Some(_), Some(_)) => "albedo and normal",
+        (Some(_), None) => "albedo",
+        _ => {
+            eprintln!(
+                "warning: the image has no albedo and normal layers; denoising the beauty \
+                 alone keeps less detail (render with --denoise or --aov albedo,normal)"
+            );
+            "nothing"
+        }
+    };
+    denoise(image, threads.unwrap_or(0) as usize)?;
+    if !quiet {
+        eprintln!(
+            "denoised {}x{} guided by {guides} in {:.2} s",
+            image.width,
+            image.height,
+            start.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
+/// Reads a gridtrace EXR, denoises it (from its noisy layer when it was denoised before)
+/// and writes the result with its record.
+pub fn run_denoise(args: &DenoiseArgs) -> Result<()> {
+    set_memory_budget(args.max_memory.unwrap_or(0));
+    {
+        let _writing = output_lock();
+        check_writable(&args.output)?;
+    }
+    let part = read_part(&args.input)?;
+    let mut image = part
+        .read_image()
+        .with_context(|| format!("reading {}", args.input.display()))?;
+    denoise_for_output(&mut image, args.threads, args.quiet)?;
+    let mut record = part.record;
+    record.denoised = true;
+    let _writing = output_lock();
+    write_image_with_record(&args.output, &image, Some(&record), args.view_transform)?;
+    set_phase(Phase::Finished);
+    if !args.quiet {
+        eprintln!("wrote {}", args.output.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,58 @@
+//! `gridtrace merge`: parts of one render into one image.
+
+use std::time::Instant;
+
+use anyhow::Result;
+
+use super::args::MergeArgs;
+use super::denoise::denoise_for_output;
+use super::signals::{Phase, output_lock, set_phase};
+use crate::denoise::check_available;
+use crate::limits::set_memory_budget;
+use crate::merge::merge_files;
+use crate::output::{check_writable, write_image_with_record};
+use crate::record::format_range;
+
+/// Reads, checks and merges the parts, and writes the merged image.
+pub fn run_merge(args: &MergeArgs) -> Result<()> {
+    set_memory_budget(args.max_memory.unwrap_or(0));
+    if args.denoise {
+        check_available()?;
+    }
+    {
+        let _writing = output_lock();
+        check_writable(&args.output)?;
+    }
+    let start = Instant::now();
+    let (mut image, mut record) = merge_files(&args.parts, args.samples.clone())?;
+    if record.nonfinite > 0 {
+        eprintln!(
+            "warning: {} sample(s) were NaN or infinite and were dropped",
+            record.nonfinite
+        );
+    }
+    if args.denoise {
+        denoise_for_output(&mut image, args.threads, args.quiet)?;
+        record.denoised = true;
+    }
+    {
+        let _writing = output_lock();
+        write_image_with_record(&args.output, &image, Some(&record), args.view_transform)?;
+        set_phase(Phase::Finished);
+    }
+    if !args.quiet {
+        eprintln!(
+            "merged {} part(s) of {} ({}x{}, camera {}): samples {} in {:.2} s; wrote {}",
+            args.parts.len(),
+            record.scene_name,
+            image.width,
+            image.height,
+            record.identity.camera,
+            format_range(&record.samples),
+            start.elapsed().as_secs_f64(),
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
