@@ -118,10 +118,10 @@ fn candidates() -> Vec<PathBuf> {
 }
 
 impl Api {
-    /// Loads the library from the first candidate that opens.
-    fn load() -> Result<Api, DenoiseError> {
+    /// Loads the library from the first of `paths` that opens.
+    fn load_from(paths: Vec<PathBuf>) -> Result<Api, DenoiseError> {
         let mut tried = Vec::new();
-        for path in candidates() {
+        for path in paths {
             // SAFETY: loading runs the library's initialisers; OIDN's only set up its own
             // state.
             match unsafe { libloading::Library::new(&path) } {
@@ -132,6 +132,11 @@ impl Api {
         Err(DenoiseError::NotInstalled {
             tried: format!("tried {}", tried.join(", ")),
         })
+    }
+
+    /// Loads the library from where gridtrace looks for it ([`candidates`]).
+    fn load() -> Result<Api, DenoiseError> {
+        Api::load_from(candidates())
     }
 
     fn bind(library: libloading::Library, path: &Path) -> Result<Api, DenoiseError> {
@@ -254,12 +259,34 @@ fn denoise_bytes(pixels: usize) -> u64 {
 /// albedo and normal layers when the image has them (both, or albedo alone, as OIDN
 /// accepts), and the beauty alone otherwise.
 pub fn denoise(image: &mut Image, threads: usize) -> Result<(), DenoiseError> {
+    denoise_with(image, threads, Api::load)
+}
+
+/// [`denoise`] with the library at `library` (a file, or a folder holding it).
+pub fn denoise_with_library(
+    image: &mut Image,
+    threads: usize,
+    library: &Path,
+) -> Result<(), DenoiseError> {
+    let path = if library.is_dir() {
+        library.join(LIBRARY_NAME)
+    } else {
+        library.to_path_buf()
+    };
+    denoise_with(image, threads, || Api::load_from(vec![path]))
+}
+
+fn denoise_with(
+    image: &mut Image,
+    threads: usize,
+    load: impl FnOnce() -> Result<Api, DenoiseError>,
+) -> Result<(), DenoiseError> {
     let (width, height) = (image.width as usize, image.height as usize);
     check_memory(
         || format!("denoising a {width}x{height} image"),
         denoise_bytes(width * height),
     )?;
-    let api = Api::load()?;
+    let api = load()?;
     let flat = |v: &[Vec3]| v.iter().flat_map(|p| p.to_array()).collect::<Vec<f32>>();
     let mut color = flat(&image.pixels);
     let mut output = vec![0.0f32; color.len()];
