@@ -74,7 +74,7 @@ fn run() {
         let settings = RenderSettings {
             width: 48,
             height: 48,
-            spp: if count >= 1000 { 1 } else { 4 },
+            samples: 0..(if count >= 1000 { 1 } else { 4 }),
             max_depth: 4,
             ..RenderSettings::default()
         };

@@ -318,7 +318,10 @@ fn denoise_with(
             device.filter(
                 width,
                 height,
-                &mut [(layer, buffer.as_mut_slice()), ("output", clean.as_mut_slice())],
+                &mut [
+                    (layer, buffer.as_mut_slice()),
+                    ("output", clean.as_mut_slice()),
+                ],
                 &[],
             )?;
             *buffer = clean;

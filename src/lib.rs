@@ -22,7 +22,7 @@
 //! let scene = b.build();
 //! let camera = Camera::framing(&scene.bounds(), 1.0);
 //! let renderer = Renderer::new(&scene);
-//! let settings = RenderSettings { width: 8, height: 8, spp: 4, ..Default::default() };
+//! let settings = RenderSettings { width: 8, height: 8, samples: 0..4, ..Default::default() };
 //! let (image, _stats) = renderer.render(&camera, &settings, &|| {});
 //! assert!((image.pixel(4, 4).x - 2.0).abs() < 1e-5);
 //! ```

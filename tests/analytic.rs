@@ -352,7 +352,7 @@ fn objects_in_radiative_equilibrium_are_invisible() {
         let settings = RenderSettings {
             width: 32,
             height: 32,
-            spp: 256,
+            samples: 0..256,
             max_depth: 1000,
             seed: 5,
             strategy,

@@ -94,7 +94,7 @@ fn render_aovs(scene: &Scene, camera: &Camera, spp: u32) -> Image {
     let settings = RenderSettings {
         width: SIZE,
         height: SIZE,
-        spp,
+        samples: 0..spp,
         aovs: AovSet::ALL,
         ..RenderSettings::default()
     };
@@ -148,7 +148,11 @@ fn covered_pixels(
 /// Checks albedo (exactly the texel colour), depth (within 0.2 % of the centre's: the
 /// distance varies that little across a pixel here), normal (the square's) and coverage.
 fn check_square(image: &Image, expected: &[(usize, Vec3, f32)], normal: Vec3) {
-    assert!(expected.len() > 300, "only {} pixels to check", expected.len());
+    assert!(
+        expected.len() > 300,
+        "only {} pixels to check",
+        expected.len()
+    );
     let aovs = &image.aovs;
     for &(i, albedo, depth) in expected {
         let got = aovs.albedo.as_ref().unwrap()[i];
@@ -157,9 +161,15 @@ fn check_square(image: &Image, expected: &[(usize, Vec3, f32)], normal: Vec3) {
             "pixel {i}: albedo {got}, texture {albedo}"
         );
         let d = aovs.depth.as_ref().unwrap()[i];
-        assert!((d / depth - 1.0).abs() < 2e-3, "pixel {i}: depth {d}, expected {depth}");
+        assert!(
+            (d / depth - 1.0).abs() < 2e-3,
+            "pixel {i}: depth {d}, expected {depth}"
+        );
         let n = aovs.normal.as_ref().unwrap()[i];
-        assert!((n - normal).length() < 1e-4, "pixel {i}: normal {n}, expected {normal}");
+        assert!(
+            (n - normal).length() < 1e-4,
+            "pixel {i}: normal {n}, expected {normal}"
+        );
         assert_eq!(aovs.coverage.as_ref().unwrap()[i], 1.0);
     }
 }
@@ -238,7 +248,9 @@ fn normals_of_a_sphere_are_its_analytic_normals() {
             if !inside {
                 continue;
             }
-            let expected = meet(x as f32 + 0.5, y as f32 + 0.5, 1.0).unwrap().normalize();
+            let expected = meet(x as f32 + 0.5, y as f32 + 0.5, 1.0)
+                .unwrap()
+                .normalize();
             let got = image.aovs.normal.as_ref().unwrap()[(y * SIZE + x) as usize];
             worst = worst.max((got - expected).length());
             checked += 1;
@@ -286,7 +298,10 @@ fn layers_of_parts_merge_like_the_beauty() {
             (mp.normal, wp.normal),
             (mp.position, wp.position),
         ] {
-            assert!((a - b).abs().max_element() <= 4e-7 * b.abs().max_element().max(1.0), "{i}: {a} {b}");
+            assert!(
+                (a - b).abs().max_element() <= 4e-7 * b.abs().max_element().max(1.0),
+                "{i}: {a} {b}"
+            );
         }
         assert!(close(mp.depth, wp.depth, MERGE_TOLERANCE), "{i}");
         assert_eq!(mp.coverage, wp.coverage);

@@ -75,7 +75,7 @@ fn denoising_16_spp_cuts_the_error_against_cycles_five_fold() {
         let settings = RenderSettings {
             width: SIZE as u32,
             height: SIZE as u32,
-            spp: 16,
+            samples: 0..16,
             max_depth: MAX_DEPTH,
             aovs: AovSet {
                 albedo: true,

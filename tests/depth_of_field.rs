@@ -44,7 +44,7 @@ fn spot(z: f32, side: f32, radius: f32, focus: f32) -> (f64, f64) {
     let settings = RenderSettings {
         width: SIZE,
         height: SIZE,
-        spp: 4096,
+        samples: 0..4096,
         max_depth: 1,
         ..RenderSettings::default()
     };

@@ -78,8 +78,8 @@ fn decode(stream: &[u8]) -> Seen {
                 let (x, y, w, h) = (f.int(), f.int(), f.int(), f.int());
                 let offsets: Vec<i64> = (0..n).map(|_| f.long()).collect();
                 let strides: Vec<i64> = (0..n).map(|_| f.long()).collect();
-                let data: Vec<f32> = std::iter::from_fn(|| (!f.0.is_empty()).then(|| f.float()))
-                    .collect();
+                let data: Vec<f32> =
+                    std::iter::from_fn(|| (!f.0.is_empty()).then(|| f.float())).collect();
                 for py in 0..h {
                     for px in 0..w {
                         let k = (py * w + px) as i64;
@@ -134,7 +134,10 @@ fn the_viewer_is_shown_the_image_that_is_written() {
     assert!(out.status.success(), "{}", binary::stderr(&out));
     let seen = decode(&server.join().unwrap());
     let (name, w, h, channels) = seen.created.unwrap();
-    assert_eq!((name.as_str(), w, h), ("gridtrace: cornell_box.glb", 20, 12));
+    assert_eq!(
+        (name.as_str(), w, h),
+        ("gridtrace: cornell_box.glb", 20, 12)
+    );
     assert_eq!(channels, ["R", "G", "B", "A"]);
     assert!(seen.updates >= 2, "{} updates", seen.updates);
     let written = read_exr_pixels(&dir.path().join("shown.exr")).unwrap();

@@ -174,7 +174,7 @@ fn estimate(
             let settings = RenderSettings {
                 width: size,
                 height: size,
-                spp,
+                samples: 0..spp,
                 max_depth: 8,
                 seed,
                 strategy,
@@ -324,7 +324,7 @@ fn furnace_mean(scene: &Scene, strategy: Strategy, seed: u64) -> (f64, f64) {
     let settings = RenderSettings {
         width: 24,
         height: 24,
-        spp: 64,
+        samples: 0..64,
         max_depth: 1000,
         seed,
         strategy,
@@ -370,7 +370,7 @@ fn same_seed_same_image_whatever_the_thread_count() {
     let settings = RenderSettings {
         width: 40,
         height: 40,
-        spp: 4,
+        samples: 0..4,
         seed: 42,
         ..Default::default()
     };
@@ -417,7 +417,7 @@ fn a_scene_without_emitters_renders_black() {
     let settings = RenderSettings {
         width: 8,
         height: 8,
-        spp: 2,
+        samples: 0..2,
         ..Default::default()
     };
     let (image, _) = renderer.render(&camera_at(0.0, 60.0), &settings, &|| {});

@@ -52,8 +52,7 @@ fn render(renderer: &Renderer, camera: &Camera, range: Range<u32>, seed: u64) ->
     let settings = RenderSettings {
         width: SIZE,
         height: SIZE,
-        spp: range.end - range.start,
-        first_sample: range.start,
+        samples: range.clone(),
         max_depth: 8,
         seed,
         ..RenderSettings::default()

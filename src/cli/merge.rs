@@ -55,4 +55,3 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
     }
     Ok(())
 }
-

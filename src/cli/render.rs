@@ -66,7 +66,11 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         return Ok(Outcome::Completed);
     }
     // With a time limit and no --spp, as many samples as the time allows.
-    let default_spp = if args.time_limit.is_some() { 1 << 20 } else { 64 };
+    let default_spp = if args.time_limit.is_some() {
+        1 << 20
+    } else {
+        64
+    };
     let samples = args
         .samples
         .clone()
@@ -172,8 +176,7 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let settings = RenderSettings {
         width,
         height,
-        spp: samples.end - samples.start,
-        first_sample: samples.start,
+        samples: samples.clone(),
         max_depth: args.max_depth,
         seed: args.seed,
         strategy: Strategy::Mis,
@@ -239,7 +242,7 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         denoised: image.aovs.noisy.is_some(),
     };
     let bar = progress_bar(
-        height as u64 * settings.spp as u64,
+        height as u64 * settings.spp() as u64,
         args.quiet || args.time_limit.is_some(),
     );
     let mut display = args.display.as_deref().map(|address| {
@@ -283,8 +286,8 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     if let Some(e) = checkpoint_error {
         eprintln!("warning: a checkpoint could not be written: {e}");
     }
-    let interrupted = stats.spp < settings.spp && stop.load(Ordering::Relaxed);
-    if !interrupted && stats.spp < settings.spp {
+    let interrupted = stats.spp < settings.spp() && stop.load(Ordering::Relaxed);
+    if !interrupted && stats.spp < settings.spp() {
         let why = if settings
             .time_limit
             .is_some_and(|limit| stats.elapsed + stats.elapsed / stats.spp.max(1) > limit)
@@ -296,7 +299,7 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         eprintln!(
             "{why} after {} of at most {} passes ({:.2} samples per pixel on average)",
             stats.spp,
-            settings.spp,
+            settings.spp(),
             stats.samples as f64 / (width as f64 * height as f64)
         );
     } else if settings.noise_threshold.is_some() && !args.quiet {
@@ -310,7 +313,7 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         eprintln!(
             "stopped after {} of {} samples per pixel (samples {}); writing the image so far",
             stats.spp,
-            settings.spp,
+            settings.spp(),
             format_range(&image.samples())
         );
     }

@@ -41,7 +41,7 @@ impl Schedule {
 
     /// True when pixels are judged after `passes` passes.
     pub fn check_after(&self, passes: u32) -> bool {
-        passes >= self.min_samples && (passes - self.min_samples) % CHECK_EVERY == 0
+        passes >= self.min_samples && (passes - self.min_samples).is_multiple_of(CHECK_EVERY)
     }
 
     /// The estimated error of a pixel's mean over its `n` samples.
@@ -56,7 +56,12 @@ impl Schedule {
     }
 
     /// True when the pixel may stop.
-    pub fn converged(&self, beauty: &PixelAccumulator, features: &FeatureAccumulator, n: u32) -> bool {
+    pub fn converged(
+        &self,
+        beauty: &PixelAccumulator,
+        features: &FeatureAccumulator,
+        n: u32,
+    ) -> bool {
         n >= self.min_samples && Schedule::error(beauty, features, n) < f64::from(self.threshold)
     }
 }
@@ -79,7 +84,9 @@ mod tests {
     #[test]
     fn error_is_the_standard_error_over_root_intensity() {
         // Samples 0 and 2 alternating: mean 1, sample variance 64/63 · 1, n = 64.
-        let values: Vec<f32> = (0..64).map(|i| if i % 2 == 0 { 0.0 } else { 2.0 }).collect();
+        let values: Vec<f32> = (0..64)
+            .map(|i| if i % 2 == 0 { 0.0 } else { 2.0 })
+            .collect();
         let (b, f) = pixel(&values);
         let expected = (64.0f64 / 63.0 / 64.0).sqrt() / (1.0 + INTENSITY_FLOOR).sqrt();
         let error = Schedule::error(&b, &f, 64);

@@ -326,7 +326,11 @@ mod tests {
         let set = AovSet::parse("variance, albedo,depth").unwrap();
         assert_eq!(set.label(), "albedo,depth,variance");
         assert_eq!(AovSet::parse("all").unwrap(), AovSet::ALL);
-        assert!(AovSet::parse("albedo,beauty").unwrap_err().contains("'beauty'"));
+        assert!(
+            AovSet::parse("albedo,beauty")
+                .unwrap_err()
+                .contains("'beauty'")
+        );
         assert!(!AovSet::parse("").unwrap().any());
     }
 

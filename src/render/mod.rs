@@ -3,11 +3,11 @@
 //! [`Renderer`] holds everything derived from a [`Scene`] once (acceleration structure,
 //! light list, BSDFs); [`Renderer::render`] turns a camera into an [`Image`].
 
+pub mod adaptive;
 pub mod aov;
 mod bsdf;
 mod camera;
 mod film;
-pub mod adaptive;
 mod filter;
 mod integrator;
 mod lights;
@@ -16,15 +16,16 @@ pub mod sampling;
 mod shading;
 mod surface;
 
+pub use aov::{AovImage, AovSet, Features};
 pub use bsdf::{Bsdf, BsdfSample, fresnel_dielectric};
 pub use camera::RayGenerator;
-pub use aov::{AovImage, AovSet, Features};
 pub use film::{Film, Image, PixelAccumulator};
 pub use filter::{FilterKind, PixelFilter, profile as filter_profile};
 pub use integrator::{PathResult, Strategy};
 pub use lights::{LightSample, LightSet};
 pub use surface::{gamma, interpolate_with_error, offset_ray_origin, transform_point_with_error};
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -37,18 +38,16 @@ use sampling::mix64;
 use surface::InstanceFrame;
 
 /// What to render and how.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     /// Image width in pixels.
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Samples per pixel.
-    pub spp: u32,
-    /// Index of the first sample: the render takes samples `first_sample..first_sample + spp`
-    /// of every pixel, so a long render can be split into ranges taken by different
-    /// processes and merged (see [`crate::merge`]).
-    pub first_sample: u32,
+    /// Which samples of every pixel to take: `0..spp` for a whole render; a range
+    /// `A..B` lets a long render be split among processes and merged (see
+    /// [`crate::merge`]).
+    pub samples: Range<u32>,
     /// Most scattering events along a path (0: emitters seen directly only).
     pub max_depth: u32,
     /// Seed of every random stream: the same seed gives the same image.
@@ -73,8 +72,7 @@ impl Default for RenderSettings {
         RenderSettings {
             width: 512,
             height: 512,
-            spp: 64,
-            first_sample: 0,
+            samples: 0..64,
             max_depth: 16,
             seed: 0,
             strategy: Strategy::Mis,
@@ -84,6 +82,13 @@ impl Default for RenderSettings {
             noise_threshold: None,
             time_limit: None,
         }
+    }
+}
+
+impl RenderSettings {
+    /// Samples per pixel asked for.
+    pub fn spp(&self) -> u32 {
+        self.samples.len() as u32
     }
 }
 
@@ -197,13 +202,16 @@ impl<'a> Renderer<'a> {
         let timed = camera.motion.is_some() || self.scene.has_moving_geometry();
         let filter = PixelFilter::new(settings.filter, settings.filter_width);
         let width = settings.width as usize;
-        let spp = settings.spp.max(1).min(u32::MAX - settings.first_sample);
+        let first_sample = settings.samples.start;
+        let spp = settings.spp().max(1);
         let seed = mix64(settings.seed);
-        let adaptive = settings.noise_threshold.map(|t| adaptive::Schedule::new(t, spp));
+        let adaptive = settings
+            .noise_threshold
+            .map(|t| adaptive::Schedule::new(t, spp));
         let mut film = Film::new(
             settings.width,
             settings.height,
-            settings.first_sample,
+            first_sample,
             settings.aovs,
             adaptive.is_some(),
         );
@@ -216,7 +224,7 @@ impl<'a> Renderer<'a> {
         };
         while stats.spp < spp {
             let pass_start = Instant::now();
-            let sample = settings.first_sample + stats.spp;
+            let sample = first_sample + stats.spp;
             let (rays, samples) = film
                 .rows()
                 .into_par_iter()

@@ -152,7 +152,7 @@ pub fn render_filtered(
     let settings = RenderSettings {
         width: SIZE as u32,
         height: SIZE as u32,
-        spp,
+        samples: 0..spp,
         max_depth: MAX_DEPTH,
         seed,
         filter,
