@@ -34,8 +34,12 @@ const MAX_PART_PIXELS: usize = 1 << 28;
 /// header whose pixels would need more than this many times the file's size is damaged.
 const MAX_COMPRESSION_RATIO: u64 = 2048;
 
-/// Bytes of RGBA f32 pixel data per pixel in a part.
-const PART_BYTES_PER_PIXEL: u64 = 16;
+/// Bytes of one f32 channel per pixel.
+const CHANNEL_BYTES: u64 = 4;
+
+/// Most channels a part may have: gridtrace writes at most 23 (the beauty's four and every
+/// layer's).
+const MAX_PART_CHANNELS: usize = 32;
 
 /// Memory a merge holds per pixel: the accumulators, one part's pixels and the result,
 /// with all their layers.
@@ -199,10 +203,15 @@ pub fn read_part(path: &Path) -> Result<Part, MergeError> {
             "{width}x{height} is more pixels than gridtrace renders by default"
         )));
     }
+    if header.channels > MAX_PART_CHANNELS {
+        return Err(part(record).damaged(format!(
+            "it has {} channels; gridtrace writes at most {MAX_PART_CHANNELS}",
+            header.channels
+        )));
+    }
     let file_size = std::fs::metadata(path).map_or(0, |m| m.len());
-    if (pixels as u64).saturating_mul(PART_BYTES_PER_PIXEL)
-        > file_size.saturating_mul(MAX_COMPRESSION_RATIO)
-    {
+    let bytes = (pixels as u64).saturating_mul(CHANNEL_BYTES * header.channels.max(4) as u64);
+    if bytes > file_size.saturating_mul(MAX_COMPRESSION_RATIO) {
         return Err(part(record).damaged(format!(
             "the header says {width}x{height} pixels, more than its {file_size} bytes can hold"
         )));

@@ -319,3 +319,49 @@ fn layers_of_parts_merge_like_the_beauty() {
         }
     }
 }
+
+#[test]
+fn a_part_with_more_channels_than_gridtrace_writes_is_refused_before_its_pixels() {
+    use exr::prelude::*;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell_box.glb");
+    let out = binary::gridtrace(
+        &[
+            scene.to_str().unwrap(),
+            "--width",
+            "8",
+            "--spp",
+            "1",
+            "-q",
+            "-o",
+            "part.exr",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", binary::stderr(&out));
+    let header = gridtrace::output::read_exr_header(&dir.path().join("part.exr")).unwrap();
+    let record = &header.text["gridtrace/record"];
+    // The same record over 40 channels of 8×8 zeros.
+    let channels: Vec<AnyChannel<FlatSamples>> = (0..40)
+        .map(|c| {
+            AnyChannel::new(
+                format!("layer{c}.Y").as_str(),
+                FlatSamples::F32(vec![0.0; 64]),
+            )
+        })
+        .collect();
+    let layer = Layer::new(
+        (8, 8),
+        LayerAttributes::default(),
+        Encoding::default(),
+        AnyChannels::sort(channels.into()),
+    );
+    let mut image = exr::image::Image::from_layer(layer);
+    image.attributes.other.insert(
+        Text::from("gridtrace/record"),
+        AttributeValue::Text(Text::from(record.as_str())),
+    );
+    image.write().to_file(dir.path().join("wide.exr")).unwrap();
+    let err = gridtrace::merge::read_part(&dir.path().join("wide.exr")).unwrap_err();
+    assert!(err.to_string().contains("40 channels"), "{err}");
+}

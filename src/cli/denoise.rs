@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use super::args::DenoiseArgs;
 use super::signals::{Phase, output_lock, set_phase};
 use crate::denoise::denoise;
-use crate::limits::set_memory_budget;
+use crate::limits::{check_memory, set_memory_budget};
 use crate::merge::read_part;
 use crate::output::{check_writable, write_image_with_record};
 use crate::render::Image;
@@ -47,6 +47,12 @@ pub fn run_denoise(args: &DenoiseArgs) -> Result<()> {
         check_writable(&args.output)?;
     }
     let part = read_part(&args.input)?;
+    let (width, height) = (part.record.identity.width, part.record.identity.height);
+    // The part's channels (at most 32 f32) and the image made of them.
+    check_memory(
+        || format!("reading a {width}x{height} image"),
+        (width as u64 * height as u64).saturating_mul(2 * 32 * 4),
+    )?;
     let mut image = part
         .read_image()
         .with_context(|| format!("reading {}", args.input.display()))?;

@@ -109,6 +109,8 @@ pub struct ExrHeader {
     pub width: usize,
     /// Height of the first layer in pixels.
     pub height: usize,
+    /// Channels of the first layer.
+    pub channels: usize,
     /// The text attributes of the header, by name.
     pub text: BTreeMap<String, String>,
 }
@@ -130,6 +132,7 @@ pub fn read_header(path: &Path) -> std::result::Result<ExrHeader, String> {
     Ok(ExrHeader {
         width: header.layer_size.width(),
         height: header.layer_size.height(),
+        channels: header.channels.list.len(),
         text,
     })
 }
