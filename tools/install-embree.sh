@@ -19,21 +19,7 @@ DEST=.embree4
 if [ -e "$DEST/libembree4.so" ]; then
   exit 0
 fi
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-python3 -m pip download --quiet --no-deps --require-hashes -r tools/embree-requirements.txt -d "$work"
-mkdir -p "$DEST"
-python3 - "$work" "$DEST" <<'PY'
-import os, sys, zipfile
-work, dest = sys.argv[1], sys.argv[2]
-wheel = next(f for f in os.listdir(work) if f.endswith(".whl"))
-with zipfile.ZipFile(os.path.join(work, wheel)) as z:
-    for name in z.namelist():
-        base = os.path.basename(name)
-        if name.startswith("embreex.libs/") and base:
-            with open(os.path.join(dest, base), "wb") as out:
-                out.write(z.read(name))
-PY
+python3 tools/unpack-wheel-libs.py tools/embree-requirements.txt embreex.libs "$DEST"
 lib=$(cd "$DEST" && ls libembree4-*.so.4)
 ln -sf "$lib" "$DEST/libembree4.so"
 echo "Embree 4 in $DEST ($lib)"

@@ -12,22 +12,7 @@ DEST=.oidn/lib
 if [ -e "$DEST/libOpenImageDenoise.so.2" ]; then
   exit 0
 fi
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-python3 -m pip download --quiet --no-deps --require-hashes -r tools/oidn-requirements.txt -d "$work"
-mkdir -p "$DEST"
-python3 - "$work" "$DEST" <<'PY'
-import os, sys, zipfile
-work, dest = sys.argv[1], sys.argv[2]
-wheel = next(f for f in os.listdir(work) if f.endswith(".whl"))
-wanted = ("libOpenImageDenoise.so.2", "libOpenImageDenoise_core.so.", "libOpenImageDenoise_device_cpu.so.", "libtbb.so.12")
-with zipfile.ZipFile(os.path.join(work, wheel)) as z:
-    for info in z.infolist():
-        base = os.path.basename(info.filename)
-        if info.filename.startswith("pyoidn/oidn/lib/") and base.startswith(wanted):
-            with open(os.path.join(dest, base), "wb") as out:
-                out.write(z.read(info.filename))
-            os.chmod(os.path.join(dest, base), 0o755)
-PY
-ls "$DEST"
+python3 tools/unpack-wheel-libs.py tools/oidn-requirements.txt pyoidn/oidn/lib "$DEST" \
+  libOpenImageDenoise.so.2 libOpenImageDenoise_core.so. libOpenImageDenoise_device_cpu.so. \
+  libtbb.so.12
 echo "Open Image Denoise 2 in $DEST"
