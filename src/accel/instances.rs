@@ -14,6 +14,7 @@
 use glam::{Affine3A, Vec3};
 use rayon::prelude::*;
 
+use super::box_lanes::{BoxLanes, hits_box};
 use super::top_level::{InstanceGrid, Mailbox};
 use super::{Grid, GridHit, Ray, TraversalStats};
 use crate::scene::{Aabb, Instance, Motion, Scene, TimeSlice};
@@ -70,9 +71,16 @@ impl Entry {
     /// the ray misses its bounds. `inv_direction` is the ray direction's reciprocal.
     #[inline]
     fn local_ray(&self, ray: &Ray, inv_direction: Vec3, t_max: f32) -> Option<Ray> {
-        if self.slice.as_ref().is_some_and(|s| !s.contains(ray.time))
-            || !hits_box(&self.world_bounds, ray, inv_direction, t_max)
-        {
+        hits_box(&self.world_bounds, ray, inv_direction, t_max)
+            .then(|| self.in_grid_space(ray))
+            .flatten()
+    }
+
+    /// The ray in the grid's space, or `None` when the entry is not there at its time (its
+    /// bounds already known to be met).
+    #[inline]
+    fn in_grid_space(&self, ray: &Ray) -> Option<Ray> {
+        if self.slice.as_ref().is_some_and(|s| !s.contains(ray.time)) {
             return None;
         }
         Some(match (&self.motion, &self.object_from_world) {
@@ -106,6 +114,8 @@ pub struct SceneAccel {
     entries: Vec<Entry>,
     /// `None`: test the entries as a list.
     instance_grid: Option<InstanceGrid>,
+    /// A list's bounds, tested against each ray all at once (up to [`LIST_MAX`] entries).
+    list_bounds: Option<BoxLanes>,
 }
 
 impl SceneAccel {
@@ -161,10 +171,15 @@ impl SceneAccel {
                 InstanceGrid::build(&bounds)
             })
             .flatten();
+        let list_bounds = instance_grid
+            .is_none()
+            .then(|| BoxLanes::new(entries.iter().map(|e| e.world_bounds)))
+            .flatten();
         SceneAccel {
             grids,
             entries,
             instance_grid,
+            list_bounds,
         }
     }
 
@@ -193,13 +208,29 @@ impl SceneAccel {
                 best = Some((e, hit));
             }
         };
-        match &self.instance_grid {
-            None => {
+        match (&self.instance_grid, &self.list_bounds) {
+            (None, Some(bounds)) => {
+                let slabs = bounds.slabs(ray, inv_direction);
+                for e in 0..self.entries.len() {
+                    stats.test_instance();
+                    if !slabs.hits(e, t_max) {
+                        continue;
+                    }
+                    let entry = &self.entries[e];
+                    if let Some(hit) = entry.in_grid_space(ray).and_then(|local| {
+                        self.grids[entry.grid].intersect_counting(&local.with_t_max(t_max), stats)
+                    }) {
+                        t_max = hit.t;
+                        best = Some((e as u32, hit));
+                    }
+                }
+            }
+            (None, None) => {
                 for e in 0..self.entries.len() as u32 {
                     test(e, &mut t_max, stats);
                 }
             }
-            Some(instance_grid) => {
+            (Some(instance_grid), _) => {
                 let mut mailbox = Mailbox::new();
                 instance_grid.walk(ray, |ids, limit| {
                     for &e in ids {
@@ -230,9 +261,22 @@ impl SceneAccel {
     /// [`SceneAccel::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         let inv_direction = ray.direction.recip();
-        match &self.instance_grid {
-            None => (0..self.entries.len()).any(|e| self.occluded_by(e, ray, inv_direction, stats)),
-            Some(instance_grid) => {
+        match (&self.instance_grid, &self.list_bounds) {
+            (None, Some(bounds)) => {
+                let slabs = bounds.slabs(ray, inv_direction);
+                (0..self.entries.len()).any(|e| {
+                    stats.test_instance();
+                    let entry = &self.entries[e];
+                    slabs.hits(e, ray.t_max)
+                        && entry.in_grid_space(ray).is_some_and(|local| {
+                            self.grids[entry.grid].occluded_counting(&local, stats)
+                        })
+                })
+            }
+            (None, None) => {
+                (0..self.entries.len()).any(|e| self.occluded_by(e, ray, inv_direction, stats))
+            }
+            (Some(instance_grid), _) => {
                 let mut mailbox = Mailbox::new();
                 let mut blocked = false;
                 instance_grid.walk(ray, |ids, _| {
@@ -372,19 +416,4 @@ fn to_object(ray: &Ray, object_from_world: &Affine3A) -> Ray {
         direction: object_from_world.transform_vector3(ray.direction),
         ..*ray
     }
-}
-
-/// Slab test of the ray segment (`t_min`, `t_max`) against a box; `inv` is the reciprocal
-/// of the ray's direction, computed once per ray.
-#[inline]
-fn hits_box(b: &Aabb, ray: &Ray, inv: Vec3, t_max: f32) -> bool {
-    let t0 = (b.min - ray.origin) * inv;
-    let t1 = (b.max - ray.origin) * inv;
-    let near = t0.min(t1);
-    // Widen each slab's exit by its rounding error, so a ray through the box is never
-    // culled by rounding (pbrt-v4 §6.8.2: t_far·(1 + 2γ(3))).
-    let far = t0.max(t1) * (1.0 + 2.0 * crate::accel::SLAB_ROUNDING);
-    let t_start = ray.t_min.max(near.x).max(near.y).max(near.z);
-    let t_end = t_max.min(far.x).min(far.y).min(far.z);
-    t_start <= t_end
 }

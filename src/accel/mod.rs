@@ -1,6 +1,7 @@
 //! Ray–scene intersection: the Möller–Trumbore triangle test, a uniform grid per mesh,
 //! and a top level over the instances (a list, or a grid of their own when there are many).
 
+mod box_lanes;
 mod frame;
 pub mod grid;
 mod instances;
