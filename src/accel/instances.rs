@@ -115,7 +115,7 @@ pub struct SceneAccel {
     /// `None`: test the entries as a list.
     instance_grid: Option<InstanceGrid>,
     /// A list's bounds, tested against each ray all at once (up to [`LIST_MAX`] entries).
-    list_bounds: Option<BoxLanes>,
+    list_bounds: Option<Box<BoxLanes>>,
 }
 
 impl SceneAccel {
@@ -174,7 +174,8 @@ impl SceneAccel {
         let list_bounds = instance_grid
             .is_none()
             .then(|| BoxLanes::new(entries.iter().map(|e| e.world_bounds)))
-            .flatten();
+            .flatten()
+            .map(Box::new);
         SceneAccel {
             grids,
             entries,
