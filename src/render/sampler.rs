@@ -79,20 +79,49 @@ fn scrambled_first(index: u32, seed: u32) -> u32 {
 }
 
 /// The second Sobol dimension at `index`: generator matrix from the primitive polynomial
-/// x + 1 (direction numbers v₀ = 2³¹, vᵢ = vᵢ₋₁ ⊕ (vᵢ₋₁ ≫ 1)).
+/// x + 1 (direction numbers v₀ = 2³¹, vᵢ = vᵢ₋₁ ⊕ (vᵢ₋₁ ≫ 1)). The result is the XOR of the
+/// direction numbers of the index's set bits, taken a byte at a time from
+/// [`SOBOL_SECOND_BYTES`]: shuffled indices have random high bits, so a loop over the bits
+/// would branch unpredictably 32 times per number.
 fn sobol_second(index: u32) -> u32 {
-    let mut x = 0;
-    let mut v = 1u32 << 31;
-    let mut i = index;
-    while i != 0 {
-        if i & 1 == 1 {
-            x ^= v;
-        }
-        i >>= 1;
-        v ^= v >> 1;
-    }
-    x
+    let t = &SOBOL_SECOND_BYTES;
+    t[0][(index & 0xff) as usize]
+        ^ t[1][((index >> 8) & 0xff) as usize]
+        ^ t[2][((index >> 16) & 0xff) as usize]
+        ^ t[3][(index >> 24) as usize]
 }
+
+/// For byte `b` of an index and each value of it, the XOR of the direction numbers of its
+/// set bits.
+const SOBOL_SECOND_BYTES: [[u32; 256]; 4] = {
+    let mut direction = [0u32; 32];
+    let mut v = 1u32 << 31;
+    let mut i = 0;
+    while i < 32 {
+        direction[i] = v;
+        v ^= v >> 1;
+        i += 1;
+    }
+    let mut table = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut value = 0;
+        while value < 256 {
+            let mut x = 0;
+            let mut bit = 0;
+            while bit < 8 {
+                if value & (1 << bit) != 0 {
+                    x ^= direction[8 * b + bit];
+                }
+                bit += 1;
+            }
+            table[b][value] = x;
+            value += 1;
+        }
+        b += 1;
+    }
+    table
+};
 
 /// Owen scrambling of the bits of `x` as a nested uniform scramble: each bit flipped by a
 /// hash of the bits above it (Burley 2020, §3: the Laine–Karras permutation on reversed
@@ -135,6 +164,32 @@ fn to_unit(x: u32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The second dimension bit by bit, as its definition reads.
+    fn sobol_second_by_bits(index: u32) -> u32 {
+        let mut x = 0;
+        let mut v = 1u32 << 31;
+        let mut i = index;
+        while i != 0 {
+            if i & 1 == 1 {
+                x ^= v;
+            }
+            i >>= 1;
+            v ^= v >> 1;
+        }
+        x
+    }
+
+    #[test]
+    fn the_byte_tables_give_the_second_dimension_bit_for_bit() {
+        let mut h = 1u32;
+        for i in 0..200_000u32 {
+            h = h.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+            for index in [i, h, h | 0x8000_0000, u32::MAX - i] {
+                assert_eq!(sobol_second(index), sobol_second_by_bits(index), "{index}");
+            }
+        }
+    }
 
     /// Every elementary interval of area 2^−k holds exactly one of 2^k points.
     fn is_net(points: &[Vec2], k: u32) -> bool {
