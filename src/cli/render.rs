@@ -3,7 +3,7 @@
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
@@ -26,7 +26,7 @@ use crate::load::{LoadOptions, load_scene_with};
 use crate::output::{Format, check_writable, write_image_with_record};
 use crate::record::{RenderIdentity, RenderRecord, format_range, sha256_file, sha256_files};
 use crate::render::{
-    AovSet, Film, FilterKind, Image, RenderSettings, RenderStats, Renderer, Strategy,
+    AovSet, EarlyEnd, Film, FilterKind, Image, RenderSettings, RenderStats, Renderer, Strategy,
 };
 
 /// Loads, renders and writes as `args` says; rendering stops early, and the image so far is
@@ -286,16 +286,13 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     if let Some(e) = checkpoint_error {
         eprintln!("warning: a checkpoint could not be written: {e}");
     }
-    let interrupted = stats.spp < settings.spp() && stop.load(Ordering::Relaxed);
-    if !interrupted && stats.spp < settings.spp() {
-        let why = if settings
-            .time_limit
-            .is_some_and(|limit| stats.elapsed + stats.elapsed / stats.spp.max(1) > limit)
-        {
-            "the time limit came"
-        } else {
-            "every pixel reached the noise threshold"
-        };
+    let interrupted = stats.ended_early == Some(EarlyEnd::Stopped);
+    let why = match stats.ended_early {
+        Some(EarlyEnd::TimeLimit) => Some("the time limit came"),
+        Some(EarlyEnd::Converged) => Some("every pixel reached the noise threshold"),
+        _ => None,
+    };
+    if let Some(why) = why {
         eprintln!(
             "{why} after {} of at most {} passes ({:.2} samples per pixel on average)",
             stats.spp,

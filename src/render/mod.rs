@@ -105,6 +105,19 @@ pub struct RenderStats {
     pub elapsed: Duration,
     /// Samples per pixel taken: the requested count, or fewer if the render was stopped.
     pub spp: u32,
+    /// Why the render ended before its last pass, if it did.
+    pub ended_early: Option<EarlyEnd>,
+}
+
+/// Why a render took fewer passes than asked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EarlyEnd {
+    /// The stop flag was set (a signal).
+    Stopped,
+    /// Adaptive sampling: every pixel reached the noise threshold.
+    Converged,
+    /// The next pass would have ended after the time limit.
+    TimeLimit,
 }
 
 /// Makes the image of the samples taken so far, for a checkpoint.
@@ -267,23 +280,27 @@ impl<'a> Renderer<'a> {
             stats.rays += rays;
             stats.samples += samples;
             stats.spp += 1;
+            if stats.spp == spp {
+                break;
+            }
             if stop.load(Ordering::Relaxed) {
+                stats.ended_early = Some(EarlyEnd::Stopped);
                 break;
             }
             if let Some(schedule) = &adaptive
                 && schedule.check_after(stats.spp)
                 && film.update_active(|b, f, n| schedule.converged(b, f, n)) == 0
             {
+                stats.ended_early = Some(EarlyEnd::Converged);
                 break;
             }
             if let Some(limit) = settings.time_limit
                 && start.elapsed() + pass_start.elapsed() > limit
             {
+                stats.ended_early = Some(EarlyEnd::TimeLimit);
                 break;
             }
-            if stats.spp < spp {
-                on_pass(&|| image_so_far(&film, stats));
-            }
+            on_pass(&|| image_so_far(&film, stats));
         }
         image_so_far(&film, stats)
     }
