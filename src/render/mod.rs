@@ -305,8 +305,3 @@ impl<'a> Renderer<'a> {
         image_so_far(&film, stats)
     }
 }
-
-/// Memory a render of `width`×`height` needs for its film (see [`Film::bytes`]).
-pub fn film_bytes(width: u32, height: u32) -> u64 {
-    Film::bytes(width, height, AovSet::default(), false)
-}
