@@ -116,6 +116,25 @@ impl LightKind {
 }
 
 impl LightKind {
+    /// The largest radiant intensity (W/sr, mean over channels) it sends in any direction:
+    /// divided by a squared distance, a bound on the irradiance it brings (exact for a
+    /// point), which the light tree weighs lights by. Zero for a directional light, which
+    /// brings an irradiance instead.
+    pub fn peak_intensity(&self) -> f32 {
+        match *self {
+            LightKind::Point { intensity, .. } | LightKind::Spot { intensity, .. } => {
+                mean(intensity)
+            }
+            // Seen from anywhere, a sphere is a disc of area πr².
+            LightKind::Sphere {
+                radius, radiance, ..
+            } => PI * radius * radius * mean(radiance),
+            LightKind::Directional { .. } => 0.0,
+        }
+    }
+}
+
+impl LightKind {
     /// Emitted power (W), mean over channels: what light selection weighs and `--inspect`
     /// prints. A spot counts its cone up to halfway through the falloff; a directional
     /// light, what crosses the disc of the sphere (radius `scene_radius`) around the scene.

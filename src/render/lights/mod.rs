@@ -18,7 +18,7 @@ use super::sampling::{Distribution1d, uniform_triangle};
 use super::shading::vertex_uv;
 use super::surface::{interpolate_with_error, transform_point_with_error};
 use crate::scene::{Aabb, ColorSpace, LightKind, Motion, Scene, TextureRef, TimeSlice};
-use tree::{Cone, LightBounds, LightTree, TreeInput};
+use tree::{Cone, Distant, LightBounds, LightTree, TreeInput};
 
 /// One emitting triangle in world space.
 #[derive(Clone, Copy, Debug)]
@@ -246,16 +246,30 @@ impl LightSet {
         set
     }
 
-    /// Where `light` can send light from and to, for the light tree; for a light at
-    /// infinity, the irradiance it brings (its power is what crosses the scene's disc). A
-    /// moving triangle is bounded over the whole shutter, with any normal.
+    /// Where `light` can send light from and to and how strongly, for the light tree; for
+    /// a light at infinity, the irradiance it brings (an environment's: its power, what
+    /// crosses the scene's disc, over the disc). `power` is the light's [`LightSet::power`].
+    /// A moving triangle is bounded over the whole shutter, with any normal.
     fn bounds(&self, light: Light, power: f32) -> TreeInput {
         let disc = std::f32::consts::PI * self.scene_radius * self.scene_radius;
-        let infinite = TreeInput::Infinite(if disc > 0.0 { power / disc } else { power });
         let at = |p: Vec3| Aabb { min: p, max: p };
+        let intensity = match light {
+            // A Lambertian emitter's intensity along its normal is radiance × area, and
+            // its power π × radiance × area on each emitting side.
+            Light::Triangle(i) => {
+                let sides = if self.triangles[i].double_sided {
+                    2.0
+                } else {
+                    1.0
+                };
+                power / (std::f32::consts::PI * sides)
+            }
+            Light::Punctual(i) => self.punctual[i].peak_intensity(),
+            Light::Environment => 0.0,
+        };
         let surface = |bounds, normals, two_sided| LightBounds {
             bounds,
-            power,
+            intensity,
             normals,
             cos_emission: 0.0,
             two_sided,
@@ -287,9 +301,22 @@ impl LightSet {
                     ),
                 }
             }
-            Light::Environment => return infinite,
+            Light::Environment => {
+                return TreeInput::Infinite(Distant {
+                    irradiance: if disc > 0.0 { power / disc } else { power },
+                    towards: None,
+                });
+            }
             Light::Punctual(i) => match self.punctual[i] {
-                LightKind::Directional { .. } => return infinite,
+                LightKind::Directional {
+                    direction,
+                    irradiance,
+                } => {
+                    return TreeInput::Infinite(Distant {
+                        irradiance: irradiance.element_sum() / 3.0,
+                        towards: Some(-direction),
+                    });
+                }
                 LightKind::Point { position, .. } => surface(at(position), Cone::ALL, false),
                 LightKind::Spot {
                     position,
