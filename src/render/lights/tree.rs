@@ -308,34 +308,35 @@ impl LightTree {
         &self.leaf_lights[node.index as usize..(node.index + node.count) as usize]
     }
 
-    /// What `node` can bring to the receiver: a leaf's lights weighed one by one, an inner
-    /// node by its bounds.
-    fn node_importance(&self, node: &Node, p: Vec3, n: Vec3) -> f32 {
-        if node.count > 0 {
-            self.leaf(node)
-                .iter()
-                .map(|(_, b)| b.importance(p, n))
-                .sum()
-        } else {
-            node.bounds.importance(p, n)
+    /// Each of leaf `node`'s lights' importance for the receiver, and their sum.
+    fn leaf_weights(&self, node: &Node, p: Vec3, n: Vec3) -> ([f32; LEAF_LIGHTS], f32) {
+        let mut weights = [0.0f32; LEAF_LIGHTS];
+        for (w, (_, b)) in weights.iter_mut().zip(self.leaf(node)) {
+            *w = b.importance(p, n);
         }
+        (weights, weights.iter().sum())
     }
 
-    /// The weight of the tree (its root's importance) at a receiver, and the total with
+    /// The weight of the tree at a receiver — its root's importance, or when the root is a
+    /// leaf the sum of its lights' (then also returned, one by one) — and the total with
     /// the lights at infinity.
-    fn tree_weight(&self, p: Vec3, n: Vec3) -> (f32, f32) {
-        let tree = self
-            .nodes
-            .first()
-            .map_or(0.0, |root| self.node_importance(root, p, n));
+    fn tree_weight(&self, p: Vec3, n: Vec3) -> (f32, f32, Option<[f32; LEAF_LIGHTS]>) {
+        let (tree, weights) = match self.nodes.first() {
+            None => (0.0, None),
+            Some(root) if root.count > 0 => {
+                let (weights, sum) = self.leaf_weights(root, p, n);
+                (sum, Some(weights))
+            }
+            Some(root) => (root.bounds.importance(p, n), None),
+        };
         let distant: f32 = self.infinite.iter().map(|(_, d)| d.importance(n)).sum();
-        (tree, tree + distant)
+        (tree, tree + distant, weights)
     }
 
     /// A light for a receiver at `p` with normal `n`, and the probability it was chosen
     /// with; `u` in [0, 1).
     pub fn choose(&self, p: Vec3, n: Vec3, u: f32) -> Option<(usize, f32)> {
-        let (tree, total) = self.tree_weight(p, n);
+        let (tree, total, root_weights) = self.tree_weight(p, n);
         if !(total > 0.0 && total.is_finite()) {
             return None;
         }
@@ -358,7 +359,11 @@ impl LightTree {
         loop {
             let here = &self.nodes[node];
             if here.count > 0 {
-                return self.choose_in_leaf(here, p, n, u, pmf);
+                let (weights, sum) = match root_weights {
+                    Some(weights) => (weights, tree),
+                    None => self.leaf_weights(here, p, n),
+                };
+                return choose_in_leaf(self.leaf(here), &weights, sum, u, pmf);
             }
             let (first, second) = (node + 1, here.index as usize);
             let a = self.nodes[first].bounds.importance(p, n);
@@ -382,7 +387,7 @@ impl LightTree {
     /// The probability that [`LightTree::choose`] picks `light` for a receiver at `p` with
     /// normal `n`.
     pub fn pmf(&self, light: usize, p: Vec3, n: Vec3) -> f32 {
-        let (tree, total) = self.tree_weight(p, n);
+        let (tree, total, root_weights) = self.tree_weight(p, n);
         if !(total > 0.0 && total.is_finite()) {
             return 0.0;
         }
@@ -410,47 +415,42 @@ impl LightTree {
                 node = second;
             }
         }
-        let leaf = self.leaf(&self.nodes[node]);
-        let sum: f32 = leaf.iter().map(|(_, b)| b.importance(p, n)).sum();
+        let sum = match root_weights {
+            Some(_) => tree,
+            None => self.leaf_weights(&self.nodes[node], p, n).1,
+        };
         if !(sum > 0.0 && sum.is_finite()) {
             return 0.0;
         }
         let own = self.leaf_lights[slot as usize].1.importance(p, n);
         pmf * own / sum
     }
+}
 
-    /// One of a leaf's lights in proportion to its importance, for `u` in [0, 1), and the
-    /// probability of the whole choice given `pmf`, that of reaching the leaf.
-    fn choose_in_leaf(
-        &self,
-        leaf: &Node,
-        p: Vec3,
-        n: Vec3,
-        u: f32,
-        pmf: f32,
-    ) -> Option<(usize, f32)> {
-        let lights = self.leaf(leaf);
-        let mut weights = [0.0f32; LEAF_LIGHTS];
-        for (w, (_, b)) in weights.iter_mut().zip(lights) {
-            *w = b.importance(p, n);
-        }
-        let weights = &weights[..lights.len()];
-        let sum: f32 = weights.iter().sum();
-        if !(sum > 0.0 && sum.is_finite()) {
-            return None;
-        }
-        let target = u * sum;
-        let mut start = 0.0;
-        // The last light with weight takes what rounding leaves at the top.
-        let last = weights.iter().rposition(|&w| w > 0.0)?;
-        for (k, &w) in weights.iter().enumerate() {
-            if w > 0.0 && (target < start + w || k == last) {
-                return Some((lights[k].0, pmf * w / sum));
-            }
-            start += w;
-        }
-        None
+/// One of a leaf's `lights` in proportion to its `weights` (summing to `sum`), for `u` in
+/// [0, 1), and the probability of the whole choice given `pmf`, that of reaching the leaf.
+fn choose_in_leaf(
+    lights: &[(usize, LightBounds)],
+    weights: &[f32; LEAF_LIGHTS],
+    sum: f32,
+    u: f32,
+    pmf: f32,
+) -> Option<(usize, f32)> {
+    if !(sum > 0.0 && sum.is_finite()) {
+        return None;
     }
+    let weights = &weights[..lights.len()];
+    let target = u * sum;
+    let mut start = 0.0;
+    // The last light with weight takes what rounding leaves at the top.
+    let last = weights.iter().rposition(|&w| w > 0.0)?;
+    for (k, &w) in weights.iter().enumerate() {
+        if w > 0.0 && (target < start + w || k == last) {
+            return Some((lights[k].0, pmf * w / sum));
+        }
+        start += w;
+    }
+    None
 }
 
 #[cfg(test)]
