@@ -1,7 +1,8 @@
 //! The lights next-event estimation samples — every triangle of an emissive material in
 //! world space, every punctual light, the environment — chosen for each shading point by
-//! the light tree ([`tree`]) from their power and bounds ([`Light`] names one of them; each
-//! kind has its power, bounds and density here or beside its data, and nowhere else).
+//! the light tree ([`tree`]) from their intensity and bounds ([`Light`] names one of them;
+//! each kind has its power, intensity, bounds and density here or beside its data, and
+//! nowhere else).
 
 mod environment;
 mod sphere;
