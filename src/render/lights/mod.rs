@@ -430,10 +430,11 @@ impl LightSet {
             return None;
         }
         let corners = placed.corners.map(|c| c.0);
-        let omega = spherical::solid_angle(p, corners);
+        let directions = spherical::directions(p, corners);
+        let omega = spherical::solid_angle_of(directions);
         let by_solid_angle = spherical::use_solid_angle(omega);
         let b = if by_solid_angle {
-            spherical::sample(p, corners, omega, u)?.1
+            spherical::sample_from(p, corners, directions, omega, u)?.1
         } else {
             uniform_triangle(u)
         };

@@ -15,10 +15,20 @@ pub const MIN_SOLID_ANGLE: f64 = 3e-4;
 /// Above this solid angle (sr), likewise.
 pub const MAX_SOLID_ANGLE: f64 = 6.22;
 
-/// The solid angle triangle `corners` subtends at `p` (Van Oosterom & Strackee 1983:
-/// tan(Ω/2) = |a · (b × c)| / (1 + a·b + b·c + c·a) for unit vectors a, b, c).
+/// Unit directions from `p` to the corners of a triangle: what both the solid angle and
+/// the sample start from, computed once when both are needed.
+pub fn directions(p: Vec3, corners: [Vec3; 3]) -> [DVec3; 3] {
+    corners.map(|v| (v - p).as_dvec3().normalize_or_zero())
+}
+
+/// The solid angle triangle `corners` subtends at `p`.
 pub fn solid_angle(p: Vec3, corners: [Vec3; 3]) -> f64 {
-    let [a, b, c] = corners.map(|v| (v - p).as_dvec3().normalize_or_zero());
+    solid_angle_of(directions(p, corners))
+}
+
+/// The solid angle of the spherical triangle with unit corners `[a, b, c]` (Van Oosterom &
+/// Strackee 1983: tan(Ω/2) = |a · (b × c)| / (1 + a·b + b·c + c·a)).
+pub fn solid_angle_of([a, b, c]: [DVec3; 3]) -> f64 {
     let numerator = a.dot(b.cross(c)).abs();
     let denominator = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
     let half = numerator.atan2(denominator);
@@ -39,19 +49,31 @@ pub fn use_solid_angle(omega: f64) -> bool {
 /// angle [`solid_angle`] gave as `area`, and the barycentrics (b1, b2) of the point where it
 /// meets the triangle; `None` when the triangle is degenerate as seen from `p`.
 pub fn sample(p: Vec3, corners: [Vec3; 3], area: f64, u: Vec2) -> Option<(Vec3, Vec2)> {
-    let [a, b, c] = corners.map(|v| (v - p).as_dvec3().normalize_or_zero());
+    sample_from(p, corners, directions(p, corners), area, u)
+}
+
+/// [`sample`], given the corners' [`directions`] from `p`.
+pub fn sample_from(
+    p: Vec3,
+    corners: [Vec3; 3],
+    [a, b, c]: [DVec3; 3],
+    area: f64,
+    u: Vec2,
+) -> Option<(Vec3, Vec2)> {
     let n_ab = a.cross(b).normalize_or_zero();
     let n_ca = c.cross(a).normalize_or_zero();
     if n_ab == DVec3::ZERO || n_ca == DVec3::ZERO || area.is_nan() || area <= 0.0 {
         return None;
     }
-    // The spherical triangle's interior angle at a (its area, the sum of the three angles
-    // less π, is the solid angle already known).
-    let alpha = n_ab.dot(-n_ca).clamp(-1.0, 1.0).acos();
-    // The sub-triangle (a, b, c') of area u₀·A fixes c' on the great arc from a to c …
-    let sub_area = f64::from(u.x) * area;
-    let (sin_phi, cos_phi) = (sub_area + std::f64::consts::PI - alpha).sin_cos();
-    let (sin_alpha, cos_alpha) = alpha.sin_cos();
+    // The spherical triangle's interior angle α at a (its area, the sum of the three angles
+    // less π, is the solid angle already known), by its cosine and sine: no inverse cosine.
+    let cos_alpha = n_ab.dot(-n_ca).clamp(-1.0, 1.0);
+    let sin_alpha = n_ab.cross(n_ca).length().min(1.0);
+    // The sub-triangle (a, b, c') of area u₀·A fixes c' on the great arc from a to c; with
+    // φ = u₀·A + π − α, sin φ and cos φ follow from those of u₀·A and α.
+    let (sin_sub, cos_sub) = (f64::from(u.x) * area).sin_cos();
+    let sin_phi = cos_sub * sin_alpha - sin_sub * cos_alpha;
+    let cos_phi = -(cos_sub * cos_alpha + sin_sub * sin_alpha);
     let k1 = cos_phi + cos_alpha;
     let k2 = sin_phi - sin_alpha * a.dot(b);
     let cos_b = ((k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha)
