@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use super::block::{Block, LANES};
 use super::cells::{CellIndex, MACRO_CELLS};
-use super::overlap::{Polygon, triangle_overlaps_box};
+use super::overlap::{Polygon, TriangleBoxTest};
 use super::{DEFAULT_DENSITY, Grid};
 use crate::accel::Triangle;
 use crate::accel::frame::{GridFrame, padded, resolution};
@@ -55,13 +55,17 @@ impl Grid {
                 })
                 .filter(|tri| !tri.is_degenerate())
         };
-        let triangles: Vec<Option<Triangle>> = indices.iter().map(triangle).collect();
+        // In parallel; the results are the same on any thread count (an ordered collect,
+        // and bounds are exact minima and maxima).
+        let triangles: Vec<Option<Triangle>> = indices.par_iter().map(triangle).collect();
         let live: Vec<u32> = (0..indices.len() as u32)
+            .into_par_iter()
             .filter(|&i| triangles[i as usize].is_some())
             .collect();
-        let tight = live.iter().fold(Aabb::EMPTY, |b, &i| {
-            b.union(triangles[i as usize].unwrap().bounds())
-        });
+        let tight = live
+            .par_iter()
+            .map(|&i| triangles[i as usize].unwrap().bounds())
+            .reduce(|| Aabb::EMPTY, Aabb::union);
         let (bounds, resolution) = if tight.is_empty() {
             (
                 Aabb {
@@ -79,7 +83,7 @@ impl Grid {
                 resolution(bounds.extent(), live.len(), density)
             };
             let live_triangles: Vec<Triangle> = live
-                .iter()
+                .par_iter()
                 .map(|&i| triangles[i as usize].unwrap())
                 .collect();
             (
@@ -108,9 +112,12 @@ impl Grid {
 
     /// Fills the compact storage: the overlap tests run once, in parallel over chunks of
     /// triangles, giving (cell, triangle) pairs in triangle order; a counting sort by cell
-    /// (count → prefix sum → place) then lays them out. Within a cell, triangles keep mesh
-    /// order whatever the thread count, so ties between equal hits resolve the same way.
-    /// False, with nothing changed, if there are more references than 32-bit offsets hold.
+    /// (count → prefix sum → place the triangle numbers) lays them out in cell order, and
+    /// the blocks are then written in parallel, each from its run of that list, straight
+    /// into their final place (no pass over the whole block array before it is filled).
+    /// Within a cell, triangles keep mesh order whatever the thread count, so ties between
+    /// equal hits resolve the same way. False, with nothing changed, if there are more
+    /// references than 32-bit offsets hold.
     fn insert(&mut self, triangles: &[Option<Triangle>], live: &[u32]) -> bool {
         let m = CellIndex::macro_resolution_for(self.frame.resolution);
         let keys = (m.x * m.y * m.z) as usize * MACRO_CELLS;
@@ -130,20 +137,42 @@ impl Grid {
         if references >= u32::MAX as usize && self.frame.resolution != UVec3::ONE {
             return false;
         }
-        let mut counts = vec![0u32; keys];
+        let mut next = vec![0u32; keys];
         for &(key, _) in chunks.iter().flatten() {
-            counts[key as usize] += 1;
-        }
-        let blocks_per_cell: Vec<u32> = counts.iter().map(|n| n.div_ceil(LANES as u32)).collect();
-        let (cells, first_block) = CellIndex::build(self.frame.resolution, &blocks_per_cell);
-        // Each cell's next free lane.
-        let mut next: Vec<u32> = first_block.iter().map(|&b| b * LANES as u32).collect();
-        let mut blocks = vec![Block::EMPTY; cells.block_count()];
-        for &(key, t) in chunks.iter().flatten() {
-            let slot = next[key as usize] as usize;
-            blocks[slot / LANES].set(slot % LANES, &triangles[t as usize].unwrap(), t);
             next[key as usize] += 1;
         }
+        let blocks_per_cell: Vec<u32> = next.iter().map(|n| n.div_ceil(LANES as u32)).collect();
+        let cells = CellIndex::build(self.frame.resolution, &blocks_per_cell);
+        // Each block's run of the sorted triangle numbers (start, length), in key order as
+        // the index numbers them; `next` becomes each cell's first place in the list.
+        let mut runs: Vec<(u32, u32)> = Vec::with_capacity(cells.block_count());
+        let mut start = 0u32;
+        for n in next.iter_mut() {
+            let count = *n;
+            for first in (0..count).step_by(LANES) {
+                runs.push((start + first, (count - first).min(LANES as u32)));
+            }
+            *n = start;
+            start += count;
+        }
+        debug_assert_eq!(runs.len(), cells.block_count());
+        let mut sorted = vec![0u32; references];
+        for &(key, t) in chunks.iter().flatten() {
+            sorted[next[key as usize] as usize] = t;
+            next[key as usize] += 1;
+        }
+        drop(next);
+        let blocks: Vec<Block> = runs
+            .par_iter()
+            .map(|&(start, length)| {
+                let mut block = Block::EMPTY;
+                let run = &sorted[start as usize..(start + length) as usize];
+                for (lane, &t) in run.iter().enumerate() {
+                    block.set(lane, &triangles[t as usize].unwrap(), t);
+                }
+                block
+            })
+            .collect();
         self.cells = cells;
         self.blocks = blocks;
         self.references = references;
@@ -170,12 +199,13 @@ impl Grid {
         }
         let half = 0.5 * self.frame.cell_size + pad;
         let vertices = tri.vertices();
+        let test = TriangleBoxTest::new(vertices, half);
         // Most triangles span a few cells: test every cell of the bounding box.
         if span.x as u64 * span.y as u64 * span.z as u64 <= SMALL_BOX_CELLS {
             for z in lo.z..=hi.z {
                 for y in lo.y..=hi.y {
                     for x in lo.x..=hi.x {
-                        self.report_if_overlapped(vertices, half, UVec3::new(x, y, z), &mut f);
+                        self.report_if_overlapped(&test, UVec3::new(x, y, z), &mut f);
                     }
                 }
             }
@@ -207,23 +237,18 @@ impl Grid {
                 let first = self.frame.cell_of(row_bounds.min - pad).x;
                 let last = self.frame.cell_of(row_bounds.max + pad).x;
                 for x in first..=last {
-                    self.report_if_overlapped(vertices, half, UVec3::new(x, y, z), &mut f);
+                    self.report_if_overlapped(&test, UVec3::new(x, y, z), &mut f);
                 }
             }
         }
     }
 
-    /// Calls `f` with cell `c`'s index if the triangle overlaps it (grown by `half`).
+    /// Calls `f` with cell `c`'s index if the triangle of `test` overlaps it (grown by the
+    /// pad the test was made with).
     #[inline]
-    fn report_if_overlapped(
-        &self,
-        vertices: [Vec3; 3],
-        half: Vec3,
-        c: UVec3,
-        f: &mut impl FnMut(usize),
-    ) {
+    fn report_if_overlapped(&self, test: &TriangleBoxTest, c: UVec3, f: &mut impl FnMut(usize)) {
         let center = self.frame.bounds.min + (c.as_vec3() + 0.5) * self.frame.cell_size;
-        if triangle_overlaps_box(vertices, center, half) {
+        if test.overlaps(center) {
             f(self.storage_key(c));
         }
     }

@@ -72,9 +72,9 @@ impl CellIndex {
         macro_index * MACRO_CELLS + local_index(l.as_ivec3())
     }
 
-    /// The index of a grid whose cell with storage key `k` holds `blocks[k]` blocks; returns
-    /// it with each key's first block (the running sum of `blocks` over occupied cells).
-    pub fn build(resolution: UVec3, blocks: &[u32]) -> (CellIndex, Vec<u32>) {
+    /// The index of a grid whose cell with storage key `k` holds `blocks[k]` blocks, laid
+    /// out in key order.
+    pub fn build(resolution: UVec3, blocks: &[u32]) -> CellIndex {
         let macro_resolution = CellIndex::macro_resolution_for(resolution);
         let m = macro_resolution;
         let macro_count = (m.x * m.y * m.z) as usize;
@@ -84,7 +84,6 @@ impl CellIndex {
             macro_cells: vec![EMPTY; macro_count],
             ..CellIndex::default()
         };
-        let mut first_block = vec![0u32; blocks.len()];
         let mut total = 0u32;
         for (mi, cells) in blocks.chunks(MACRO_CELLS).enumerate() {
             if cells.iter().all(|&n| n == 0) {
@@ -97,7 +96,6 @@ impl CellIndex {
                 if n > 0 {
                     record.bits[l >> 6] |= 1 << (l & 63);
                     index.offsets.push(total);
-                    first_block[mi * MACRO_CELLS + l] = total;
                     total += n;
                 }
             }
@@ -105,7 +103,7 @@ impl CellIndex {
         }
         index.offsets.push(total);
         index.fill_distances();
-        (index, first_block)
+        index
     }
 
     /// Chebyshev distances of the empty macrocells to the nearest occupied one: a

@@ -8,32 +8,89 @@ use crate::scene::Aabb;
 /// True when the triangle `v` overlaps the box with centre `center` and half-size `half`.
 ///
 /// Touching counts as overlapping; callers pad the box to stay conservative under rounding.
+#[cfg(test)]
 pub fn triangle_overlaps_box(v: [Vec3; 3], center: Vec3, half: Vec3) -> bool {
-    let v = v.map(|p| p - center);
-    // The box's own axes: compare bounding intervals.
-    let lo = v[0].min(v[1]).min(v[2]);
-    let hi = v[0].max(v[1]).max(v[2]);
-    if lo.cmpgt(half).any() || hi.cmplt(-half).any() {
-        return false;
+    TriangleBoxTest::new(v, half).overlaps(center)
+}
+
+/// One triangle made ready to be tested against many boxes of one half-size (the cells
+/// of a grid): the thirteen separating axes of the test and the triangle's extent along
+/// each depend on the triangle alone, so they are found once and each box costs a dot
+/// product per axis. Positions are taken from the triangle's first corner, so the
+/// arithmetic stays at the scale of the triangle and its cell, not of the coordinates.
+pub struct TriangleBoxTest {
+    origin: Vec3,
+    half: Vec3,
+    /// The triangle's bounds, from `origin`.
+    lo: Vec3,
+    hi: Vec3,
+    normal: Vec3,
+    /// The box's extent along the normal.
+    normal_reach: f32,
+    /// The nine cross products of box axes and triangle edges, the triangle's interval on
+    /// each and the box's half-extent along each.
+    axes: [Vec3; 9],
+    min: [f32; 9],
+    max: [f32; 9],
+    reach: [f32; 9],
+}
+
+impl TriangleBoxTest {
+    /// Prepares triangle `v` for boxes of half-size `half`.
+    pub fn new(v: [Vec3; 3], half: Vec3) -> TriangleBoxTest {
+        let origin = v[0];
+        let v = v.map(|p| p - origin);
+        let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+        let normal = edges[0].cross(edges[1]);
+        let mut test = TriangleBoxTest {
+            origin,
+            half,
+            lo: v[0].min(v[1]).min(v[2]),
+            hi: v[0].max(v[1]).max(v[2]),
+            normal,
+            normal_reach: half.dot(normal.abs()),
+            axes: [Vec3::ZERO; 9],
+            min: [0.0; 9],
+            max: [0.0; 9],
+            reach: [0.0; 9],
+        };
+        let mut k = 0;
+        for edge in edges {
+            for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+                let a = axis.cross(edge);
+                let p = [a.dot(v[0]), a.dot(v[1]), a.dot(v[2])];
+                test.axes[k] = a;
+                test.min[k] = p[0].min(p[1]).min(p[2]);
+                test.max[k] = p[0].max(p[1]).max(p[2]);
+                test.reach[k] = half.dot(a.abs());
+                k += 1;
+            }
+        }
+        test
     }
-    // The triangle's plane.
-    let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
-    let normal = edges[0].cross(edges[1]);
-    if normal.dot(v[0]).abs() > half.dot(normal.abs()) {
-        return false;
-    }
-    // The nine cross products of triangle edges and box axes.
-    for edge in edges {
-        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
-            let a = axis.cross(edge);
-            let p = [a.dot(v[0]), a.dot(v[1]), a.dot(v[2])];
-            let r = half.dot(a.abs());
-            if p[0].min(p[1]).min(p[2]) > r || p[0].max(p[1]).max(p[2]) < -r {
+
+    /// True when the triangle overlaps the box centred at `center` (Akenine-Möller 2001:
+    /// no separating axis among the box's three, the triangle's normal and the nine cross
+    /// products). Touching counts as overlapping.
+    #[inline]
+    pub fn overlaps(&self, center: Vec3) -> bool {
+        let c = center - self.origin;
+        // The box's own axes: compare bounding intervals.
+        if (self.lo - c).cmpgt(self.half).any() || (self.hi - c).cmplt(-self.half).any() {
+            return false;
+        }
+        // The triangle's plane (through `origin`, the first corner).
+        if self.normal.dot(c).abs() > self.normal_reach {
+            return false;
+        }
+        for k in 0..9 {
+            let d = self.axes[k].dot(c);
+            if self.min[k] - d > self.reach[k] || self.max[k] - d < -self.reach[k] {
                 return false;
             }
         }
+        true
     }
-    true
 }
 
 #[cfg(test)]

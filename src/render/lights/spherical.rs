@@ -48,6 +48,7 @@ pub fn use_solid_angle(omega: f64) -> bool {
 /// A direction from `p` uniform over the solid angle of triangle `corners`, whose solid
 /// angle [`solid_angle`] gave as `area`, and the barycentrics (b1, b2) of the point where it
 /// meets the triangle; `None` when the triangle is degenerate as seen from `p`.
+#[cfg(test)]
 pub fn sample(p: Vec3, corners: [Vec3; 3], area: f64, u: Vec2) -> Option<(Vec3, Vec2)> {
     sample_from(p, corners, directions(p, corners), area, u)
 }
