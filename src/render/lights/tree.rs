@@ -468,6 +468,20 @@ mod tests {
         })
     }
 
+    /// A hard-edged spot at `p` shining down −Y with a cone of `degrees` half-angle.
+    fn spot_down(p: Vec3, intensity: f32, degrees: f32) -> TreeInput {
+        TreeInput::Placed(LightBounds {
+            bounds: Aabb { min: p, max: p },
+            intensity,
+            normals: Cone {
+                axis: -Vec3::Y,
+                cos_angle: degrees.to_radians().cos(),
+            },
+            cos_emission: 1.0,
+            two_sided: false,
+        })
+    }
+
     #[test]
     fn choices_happen_as_often_as_their_probability_says() {
         let mut lights: Vec<TreeInput> = (0..40)
@@ -527,19 +541,7 @@ mod tests {
 
     #[test]
     fn a_spot_is_never_chosen_outside_its_cone() {
-        let spot = TreeInput::Placed(LightBounds {
-            bounds: Aabb {
-                min: Vec3::Y,
-                max: Vec3::Y,
-            },
-            intensity: 100.0,
-            normals: Cone {
-                axis: -Vec3::Y,
-                cos_angle: 30f32.to_radians().cos(),
-            },
-            cos_emission: 1.0,
-            two_sided: false,
-        });
+        let spot = spot_down(Vec3::Y, 100.0, 30.0);
         let tree = LightTree::build(&[spot, point_light(Vec3::new(5.0, 1.0, 0.0), 1.0)]);
         assert!(tree.pmf(0, Vec3::new(0.3, 0.0, 0.0), Vec3::Y) > 0.9);
         assert_eq!(tree.pmf(0, Vec3::new(2.0, 0.0, 0.0), Vec3::Y), 0.0);
@@ -550,19 +552,7 @@ mod tests {
         // A spot and a point lamp of the same intensity, a point lamp twice as far and a
         // sun: within a leaf each is weighed exactly, so the probabilities are the
         // irradiances, whatever power the spot's narrow cone holds.
-        let spot = TreeInput::Placed(LightBounds {
-            bounds: Aabb {
-                min: Vec3::new(0.0, 2.0, 0.0),
-                max: Vec3::new(0.0, 2.0, 0.0),
-            },
-            intensity: 5.0,
-            normals: Cone {
-                axis: -Vec3::Y,
-                cos_angle: 20f32.to_radians().cos(),
-            },
-            cos_emission: 1.0,
-            two_sided: false,
-        });
+        let spot = spot_down(Vec3::new(0.0, 2.0, 0.0), 5.0, 20.0);
         let near = point_light(Vec3::new(0.0, 2.0, 1.0), 5.0);
         let far = point_light(Vec3::new(0.0, 4.0, 0.0), 5.0);
         let sun = TreeInput::Infinite(Distant {
