@@ -27,13 +27,17 @@ pub struct TriangleBoxTest {
     normal: Vec3,
     /// The box's extent along the normal.
     normal_reach: f32,
-    /// The nine cross products of box axes and triangle edges, the triangle's interval on
-    /// each and the box's half-extent along each.
-    axes: [Vec3; 9],
-    min: [f32; 9],
-    max: [f32; 9],
-    reach: [f32; 9],
+    /// The nine cross products of box axes and triangle edges (axis by axis, padded to
+    /// [`AXES`] with zero axes that never separate), the triangle's interval on each and the
+    /// box's half-extent along each: laid out so the nine tests compile to vector code.
+    axes: [[f32; AXES]; 3],
+    min: [f32; AXES],
+    max: [f32; AXES],
+    reach: [f32; AXES],
 }
+
+/// Lanes for the nine edge-cross-axis tests: three vectors of four.
+const AXES: usize = 12;
 
 impl TriangleBoxTest {
     /// Prepares triangle `v` for boxes of half-size `half`.
@@ -49,17 +53,19 @@ impl TriangleBoxTest {
             hi: v[0].max(v[1]).max(v[2]),
             normal,
             normal_reach: half.dot(normal.abs()),
-            axes: [Vec3::ZERO; 9],
-            min: [0.0; 9],
-            max: [0.0; 9],
-            reach: [0.0; 9],
+            axes: [[0.0; AXES]; 3],
+            min: [0.0; AXES],
+            max: [0.0; AXES],
+            reach: [0.0; AXES],
         };
         let mut k = 0;
         for edge in edges {
             for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
                 let a = axis.cross(edge);
                 let p = [a.dot(v[0]), a.dot(v[1]), a.dot(v[2])];
-                test.axes[k] = a;
+                for (i, component) in a.to_array().into_iter().enumerate() {
+                    test.axes[i][k] = component;
+                }
                 test.min[k] = p[0].min(p[1]).min(p[2]);
                 test.max[k] = p[0].max(p[1]).max(p[2]);
                 test.reach[k] = half.dot(a.abs());
@@ -83,13 +89,12 @@ impl TriangleBoxTest {
         if self.normal.dot(c).abs() > self.normal_reach {
             return false;
         }
-        for k in 0..9 {
-            let d = self.axes[k].dot(c);
-            if self.min[k] - d > self.reach[k] || self.max[k] - d < -self.reach[k] {
-                return false;
-            }
-        }
-        true
+        let [x, y, z] = &self.axes;
+        let separated: [bool; AXES] = std::array::from_fn(|k| {
+            let d = x[k] * c.x + y[k] * c.y + z[k] * c.z;
+            (self.min[k] - d > self.reach[k]) | (self.max[k] - d < -self.reach[k])
+        });
+        !separated.iter().any(|&s| s)
     }
 }
 
