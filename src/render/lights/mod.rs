@@ -337,15 +337,32 @@ impl LightSet {
                     )
                 },
                 LightKind::Sphere {
-                    position, radius, ..
-                } => surface(
-                    Aabb {
+                    position,
+                    radius,
+                    spot,
+                    ..
+                } => {
+                    let ball = Aabb {
                         min: position - Vec3::splat(radius),
                         max: position + Vec3::splat(radius),
-                    },
-                    Cone::ALL,
-                    false,
-                ),
+                    };
+                    match spot {
+                        // Every point of the ball sends light only within the cone's
+                        // directions (its falloff depends on the direction alone).
+                        Some((axis, _, cos_outer)) => LightBounds {
+                            cos_emission: 1.0,
+                            ..surface(
+                                ball,
+                                Cone {
+                                    axis,
+                                    cos_angle: cos_outer,
+                                },
+                                false,
+                            )
+                        },
+                        None => surface(ball, Cone::ALL, false),
+                    }
+                }
             },
         })
     }
@@ -676,5 +693,50 @@ impl LightSet {
             None => tri.placed,
             Some((object, k)) => PlacedTriangle::new(&self.motions[k as usize].at(time), object),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Light as SceneLight, SceneBuilder};
+
+    #[test]
+    fn a_spot_lamp_with_a_radius_is_never_chosen_outside_its_cone() {
+        // A Blender spot lamp (a ball of radius 0.1 with a 30° cone, shining down) and a
+        // point lamp: straight below the spot both count; beside it, outside the cone as
+        // seen from every point of the ball, only the point lamp can be chosen.
+        let mut builder = SceneBuilder::new();
+        let down = -Vec3::Y;
+        for kind in [
+            LightKind::Sphere {
+                position: Vec3::new(0.0, 2.0, 0.0),
+                radius: 0.1,
+                radiance: Vec3::splat(50.0),
+                spot: Some((down, 25f32.to_radians().cos(), 30f32.to_radians().cos())),
+                camera_visible: false,
+            },
+            LightKind::Point {
+                position: Vec3::new(5.0, 2.0, 0.0),
+                intensity: Vec3::ONE,
+                range: None,
+            },
+        ] {
+            builder.add_light(SceneLight {
+                name: "lamp".into(),
+                kind,
+                source: "test".into(),
+            });
+        }
+        let scene = builder.build();
+        let set = LightSet::build(&scene);
+        let spot = set
+            .lights
+            .iter()
+            .position(|l| *l == Light::Punctual(0))
+            .unwrap();
+        let below = set.tree.pmf(spot, Vec3::ZERO, Vec3::Y);
+        assert!(below > 0.5, "below the spot: {below}");
+        assert_eq!(set.tree.pmf(spot, Vec3::new(3.0, 0.0, 0.0), Vec3::Y), 0.0);
     }
 }
