@@ -4,8 +4,7 @@ use glam::{UVec3, Vec3};
 use rayon::prelude::*;
 
 use super::block::{Block, LANES};
-use super::cells::CellIndex;
-use super::merge::merge_voxels;
+use super::cells::{CellIndex, MACRO_CELLS};
 use super::overlap::{Polygon, TriangleBoxTest};
 use super::{DEFAULT_DENSITY, Grid};
 use crate::accel::Triangle;
@@ -14,10 +13,6 @@ use crate::scene::Aabb;
 
 /// Meshes of at most this many triangles (two blocks) get a single cell: a wall, a box.
 pub(super) const SINGLE_CELL_MAX: usize = 2 * LANES;
-
-/// The cost of testing one block of triangles, relative to one step of the walk, in the
-/// merge rule ([`super::merge`]).
-const BLOCK_COST: f32 = 1.0;
 
 /// Bounding boxes of at most this many cells are tested cell by cell; larger ones are
 /// walked slab by slab (clipping costs more than it saves on a few cells).
@@ -115,16 +110,17 @@ impl Grid {
         grid
     }
 
-    /// Fills the cells: the overlap tests run once, in parallel over chunks of triangles,
-    /// giving (voxel, triangle) pairs in triangle order; a counting sort by voxel (count →
-    /// prefix sum → place the triangle numbers) gives each voxel its triangles in mesh
-    /// order; the voxels are merged into cells ([`super::merge`]) and each cell's triangles
-    /// are written in blocks, in parallel, straight into their final place. Triangles keep
-    /// mesh order within a cell whatever the thread count, so ties between equal hits
-    /// resolve the same way. False, with nothing changed, if there are more references
-    /// than 32-bit offsets hold.
+    /// Fills the compact storage: the overlap tests run once, in parallel over chunks of
+    /// triangles, giving (cell, triangle) pairs in triangle order; a counting sort by cell
+    /// (count → prefix sum → place the triangle numbers) lays them out in cell order, and
+    /// the blocks are then written in parallel, each from its run of that list, straight
+    /// into their final place (no pass over the whole block array before it is filled).
+    /// Within a cell, triangles keep mesh order whatever the thread count, so ties between
+    /// equal hits resolve the same way. False, with nothing changed, if there are more
+    /// references than 32-bit offsets hold.
     fn insert(&mut self, triangles: &[Option<Triangle>], live: &[u32]) -> bool {
-        let voxels = self.frame.cell_count();
+        let m = CellIndex::macro_resolution_for(self.frame.resolution);
+        let keys = (m.x * m.y * m.z) as usize * MACRO_CELLS;
         let chunks: Vec<Vec<(u32, u32)>> = live
             .par_chunks(4096)
             .map(|chunk| {
@@ -137,60 +133,53 @@ impl Grid {
                 pairs
             })
             .collect();
-        let voxel_references: usize = chunks.iter().map(Vec::len).sum();
-        if voxel_references >= u32::MAX as usize && self.frame.resolution != UVec3::ONE {
+        let references: usize = chunks.iter().map(Vec::len).sum();
+        if references >= u32::MAX as usize && self.frame.resolution != UVec3::ONE {
             return false;
         }
-        let mut start = vec![0u32; voxels + 1];
-        for &(v, _) in chunks.iter().flatten() {
-            start[v as usize + 1] += 1;
+        let mut next = vec![0u32; keys];
+        for &(key, _) in chunks.iter().flatten() {
+            next[key as usize] += 1;
         }
-        for v in 0..voxels {
-            start[v + 1] += start[v];
+        let blocks_per_cell: Vec<u32> = next.iter().map(|n| n.div_ceil(LANES as u32)).collect();
+        let cells = CellIndex::build(self.frame.resolution, &blocks_per_cell);
+        // Each block's run of the sorted triangle numbers (start, length), in key order as
+        // the index numbers them; `next` becomes each cell's first place in the list.
+        let mut runs: Vec<(u32, u32)> = Vec::with_capacity(cells.block_count());
+        let mut start = 0u32;
+        for n in next.iter_mut() {
+            let count = *n;
+            for first in (0..count).step_by(LANES) {
+                runs.push((start + first, (count - first).min(LANES as u32)));
+            }
+            *n = start;
+            start += count;
         }
-        let mut next = start.clone();
-        let mut sorted = vec![0u32; voxel_references];
-        for &(v, t) in chunks.iter().flatten() {
-            sorted[next[v as usize] as usize] = t;
-            next[v as usize] += 1;
+        debug_assert_eq!(runs.len(), cells.block_count());
+        let mut sorted = vec![0u32; references];
+        for &(key, t) in chunks.iter().flatten() {
+            sorted[next[key as usize] as usize] = t;
+            next[key as usize] += 1;
         }
-        drop((next, chunks));
-        let merged = merge_voxels(
-            self.frame.resolution,
-            self.frame.cell_size,
-            &start,
-            sorted,
-            BLOCK_COST,
-        );
-        drop(start);
-        let blocks_per_cell: Vec<u32> = merged
-            .cells
-            .iter()
-            .map(|c| c.len.div_ceil(LANES as u32))
-            .collect();
-        let references: usize = merged.cells.iter().map(|c| c.len as usize).sum();
-        let runs: Vec<&[u32]> = merged
-            .cells
-            .iter()
-            .flat_map(|c| merged.triangles(c).chunks(LANES))
-            .collect();
+        drop(next);
         let blocks: Vec<Block> = runs
             .par_iter()
-            .map(|run| {
+            .map(|&(start, length)| {
                 let mut block = Block::EMPTY;
+                let run = &sorted[start as usize..(start + length) as usize];
                 for (lane, &t) in run.iter().enumerate() {
                     block.set(lane, &triangles[t as usize].unwrap(), t);
                 }
                 block
             })
             .collect();
-        self.cells = CellIndex::new(self.frame.resolution, &merged, &blocks_per_cell);
+        self.cells = cells;
         self.blocks = blocks;
         self.references = references;
         true
     }
 
-    /// Calls `f` with the index of every voxel the triangle overlaps.
+    /// Calls `f` with the storage key of every cell the triangle overlaps.
     fn for_each_overlapped_cell(&self, tri: &Triangle, mut f: impl FnMut(usize)) {
         let pad = self.frame.pad();
         let (lo, hi) = self.frame.cells_of_box(&tri.bounds());
@@ -202,7 +191,7 @@ impl Grid {
             for z in lo.z..=hi.z {
                 for y in lo.y..=hi.y {
                     for x in lo.x..=hi.x {
-                        f(self.frame.cell_index(UVec3::new(x, y, z)));
+                        f(self.storage_key(UVec3::new(x, y, z)));
                     }
                 }
             }
@@ -260,7 +249,7 @@ impl Grid {
     fn report_if_overlapped(&self, test: &TriangleBoxTest, c: UVec3, f: &mut impl FnMut(usize)) {
         let center = self.frame.bounds.min + (c.as_vec3() + 0.5) * self.frame.cell_size;
         if test.overlaps(center) {
-            f(self.frame.cell_index(c));
+            f(self.storage_key(c));
         }
     }
 }

@@ -1,124 +1,260 @@
-//! The cells of an irregular grid as the walk reads them: one word per voxel naming its
-//! cell, and per cell the box it answers for (in voxels) and where its blocks lie.
+//! Which cells of a grid hold triangles, and where their blocks lie: a two-level index.
 //!
-//! Cells are boxes of voxels made by merging ([`super::merge`]); a cell's box is grown over
-//! neighbours whose triangles it holds too, so a ray leaves it at the grown box's face. A
-//! step of the walk is thus one word, one cell record and the cell's blocks, whatever the
-//! size of the cell (Pérard-Gayot, Kalojanov & Slusallek 2017).
+//! The cells are grouped in macrocells of 8³. One word per macrocell says either where its
+//! record is, or — for an empty macrocell — how far the nearest occupied macrocell is
+//! (Chebyshev distance, so the walk can leap over a whole cube of empty space: proximity
+//! clouds, Cohen & Sheffer 1994). A record is one cache line: 512 occupancy bits, one per
+//! cell. Occupied cells are numbered macrocell by macrocell, so an occupied cell's number is
+//! its record's first number plus a popcount over that one cache line, and the offsets of
+//! the cells of one macrocell lie together. A ray stepping through a macrocell thus reads
+//! one record line instead of occupancy words scattered over whole rows of the grid.
 
+use std::collections::VecDeque;
 use std::ops::Range;
 
 use glam::{IVec3, UVec3};
 
-use super::merge::Merged;
+/// A macrocell is 2^MACRO_SHIFT cells along each axis.
+pub(super) const MACRO_SHIFT: i32 = 3;
+/// Cells per macrocell.
+pub(super) const MACRO_CELLS: usize = 1 << (3 * MACRO_SHIFT);
 
-/// One cell: the voxels it answers for (inclusive corners) and its blocks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(C)]
-pub(super) struct Cell {
-    pub lo: [u16; 3],
-    pub hi: [u16; 3],
-    /// `first..end` indexes the blocks.
-    pub first: u32,
-    pub end: u32,
+/// Set in a macrocell's word when it is empty; the low bits are then its distance.
+const EMPTY: u32 = 1 << 31;
+/// Distances are counted up to this (further is as good as this far).
+const MAX_DISTANCE: u32 = 255;
+
+/// Occupancy of the 512 cells of one macrocell (x fastest, then y, then z).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(C, align(64))]
+struct Record {
+    bits: [u64; MACRO_CELLS / 64],
 }
 
-impl Cell {
-    /// Where the cell's blocks lie.
-    #[inline(always)]
-    pub fn blocks(&self) -> Range<usize> {
-        self.first as usize..self.end as usize
-    }
+/// What the index says about one cell.
+pub(super) enum Lookup {
+    /// The cell's macrocell is empty, and so is every macrocell within Chebyshev distance
+    /// `distance − 1` of it.
+    EmptyMacrocell { distance: u32 },
+    /// The cell is empty (its macrocell is not).
+    EmptyCell,
+    /// The cell's blocks.
+    Blocks(Range<usize>),
 }
 
-/// The cells of a grid and the voxel-to-cell map.
+/// The two-level index of a grid's occupied cells.
 #[derive(Clone, Debug, Default)]
 pub(super) struct CellIndex {
-    resolution: UVec3,
-    /// Voxel (x fastest, then y, then z) → cell.
-    map: Vec<u32>,
-    cells: Vec<Cell>,
+    /// Macrocells per axis.
+    macro_resolution: UVec3,
+    /// Per macrocell: its record's index, or `EMPTY | distance`.
+    macro_cells: Vec<u32>,
+    records: Vec<Record>,
+    /// Number of the first occupied cell of each record.
+    record_first: Vec<u32>,
+    /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes the blocks.
+    offsets: Vec<u32>,
 }
 
 impl CellIndex {
-    /// The index of merged cells whose blocks are `blocks[k]` in number, laid out in cell
-    /// order.
-    pub fn new(resolution: UVec3, merged: &Merged, blocks: &[u32]) -> CellIndex {
-        let mut first = 0;
-        let cells = merged
-            .cells
-            .iter()
-            .zip(blocks)
-            .map(|(c, &n)| {
-                let cell = Cell {
-                    lo: c.reach_lo,
-                    hi: c.reach_hi,
-                    first,
-                    end: first + n,
-                };
-                first += n;
-                cell
-            })
-            .collect();
-        CellIndex {
-            resolution,
-            map: merged.map.clone(),
-            cells,
+    /// Macrocells per axis for a grid of `resolution` cells.
+    pub fn macro_resolution_for(resolution: UVec3) -> UVec3 {
+        (resolution + UVec3::splat((1 << MACRO_SHIFT) - 1)) >> MACRO_SHIFT as u32
+    }
+
+    /// Where cell `c` is counted in storage order (macrocell by macrocell), for a grid of
+    /// `macro_resolution` macrocells.
+    #[inline]
+    pub fn storage_key(macro_resolution: UVec3, c: UVec3) -> usize {
+        let m = c >> MACRO_SHIFT as u32;
+        let l = c & UVec3::splat((1 << MACRO_SHIFT) - 1);
+        let macro_index = (m.x + macro_resolution.x * (m.y + macro_resolution.y * m.z)) as usize;
+        macro_index * MACRO_CELLS + local_index(l.as_ivec3())
+    }
+
+    /// The index of a grid whose cell with storage key `k` holds `blocks[k]` blocks, laid
+    /// out in key order.
+    pub fn build(resolution: UVec3, blocks: &[u32]) -> CellIndex {
+        let macro_resolution = CellIndex::macro_resolution_for(resolution);
+        let m = macro_resolution;
+        let macro_count = (m.x * m.y * m.z) as usize;
+        debug_assert_eq!(blocks.len(), macro_count * MACRO_CELLS);
+        let mut index = CellIndex {
+            macro_resolution,
+            macro_cells: vec![EMPTY; macro_count],
+            ..CellIndex::default()
+        };
+        let mut total = 0u32;
+        for (mi, cells) in blocks.chunks(MACRO_CELLS).enumerate() {
+            if cells.iter().all(|&n| n == 0) {
+                continue;
+            }
+            let mut record = Record::default();
+            index.macro_cells[mi] = index.records.len() as u32;
+            index.record_first.push(index.offsets.len() as u32);
+            for (l, &n) in cells.iter().enumerate() {
+                if n > 0 {
+                    record.bits[l >> 6] |= 1 << (l & 63);
+                    index.offsets.push(total);
+                    total += n;
+                }
+            }
+            index.records.push(record);
+        }
+        index.offsets.push(total);
+        index.fill_distances();
+        index
+    }
+
+    /// Chebyshev distances of the empty macrocells to the nearest occupied one: a
+    /// breadth-first search from the occupied macrocells over 26 neighbours.
+    fn fill_distances(&mut self) {
+        let m = self.macro_resolution.as_ivec3();
+        let mut queue: VecDeque<IVec3> = VecDeque::new();
+        let mut distance = vec![u32::MAX; self.macro_cells.len()];
+        for z in 0..m.z {
+            for y in 0..m.y {
+                for x in 0..m.x {
+                    let c = IVec3::new(x, y, z);
+                    if self.macro_cells[self.macro_index(c)] & EMPTY == 0 {
+                        distance[self.macro_index(c)] = 0;
+                        queue.push_back(c);
+                    }
+                }
+            }
+        }
+        while let Some(c) = queue.pop_front() {
+            let d = distance[self.macro_index(c)];
+            if d >= MAX_DISTANCE {
+                continue;
+            }
+            for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let n = c + IVec3::new(dx, dy, dz);
+                        if n.cmplt(IVec3::ZERO).any() || n.cmpge(m).any() {
+                            continue;
+                        }
+                        let i = self.macro_index(n);
+                        if distance[i] == u32::MAX {
+                            distance[i] = d + 1;
+                            queue.push_back(n);
+                        }
+                    }
+                }
+            }
+        }
+        for (word, d) in self.macro_cells.iter_mut().zip(distance) {
+            if *word & EMPTY != 0 {
+                *word = EMPTY | d.min(MAX_DISTANCE);
+            }
         }
     }
 
-    /// The cell that voxel `v` (inside the grid) belongs to.
+    #[inline]
+    fn macro_index(&self, m: IVec3) -> usize {
+        let r = self.macro_resolution;
+        (m.x as u32 + r.x * (m.y as u32 + r.y * m.z as u32)) as usize
+    }
+
+    /// What the index says about cell `c` (inside the grid).
     #[inline(always)]
-    pub fn cell_at(&self, v: IVec3) -> &Cell {
-        let r = self.resolution;
-        let i = v.x as u32 + r.x * (v.y as u32 + r.y * v.z as u32);
-        &self.cells[self.map[i as usize] as usize]
+    pub fn lookup(&self, c: IVec3) -> Lookup {
+        let word = self.macro_cells[self.macro_index(c >> MACRO_SHIFT)];
+        if word & EMPTY != 0 {
+            return Lookup::EmptyMacrocell {
+                distance: word & !EMPTY,
+            };
+        }
+        let record = &self.records[word as usize];
+        let l = local_index(c & IVec3::splat((1 << MACRO_SHIFT) - 1));
+        let bits = record.bits[l >> 6];
+        let bit = 1u64 << (l & 63);
+        if bits & bit == 0 {
+            return Lookup::EmptyCell;
+        }
+        let before: u32 = record.bits[..l >> 6].iter().map(|w| w.count_ones()).sum();
+        let k =
+            (self.record_first[word as usize] + before + (bits & (bit - 1)).count_ones()) as usize;
+        Lookup::Blocks(self.offsets[k] as usize..self.offsets[k + 1] as usize)
     }
 
-    /// All cells.
-    pub fn cells(&self) -> &[Cell] {
-        &self.cells
-    }
-
-    /// Cells that hold triangles.
+    /// Occupied cells.
     pub fn occupied(&self) -> usize {
-        self.cells.iter().filter(|c| c.end > c.first).count()
+        self.offsets.len() - 1
     }
 
     /// Blocks over all cells.
     pub fn block_count(&self) -> usize {
-        self.cells.last().map_or(0, |c| c.end as usize)
+        *self.offsets.last().unwrap_or(&0) as usize
     }
 
     /// Bytes held.
     pub fn bytes(&self) -> usize {
-        std::mem::size_of_val(self.map.as_slice()) + std::mem::size_of_val(self.cells.as_slice())
+        std::mem::size_of_val(self.macro_cells.as_slice())
+            + std::mem::size_of_val(self.records.as_slice())
+            + std::mem::size_of_val(self.record_first.as_slice())
+            + std::mem::size_of_val(self.offsets.as_slice())
     }
 
-    /// Checks the index's invariants; returns a description of the first broken one.
-    pub fn validate(&self) -> Result<(), String> {
-        let r = self.resolution;
-        if self.map.len() != (r.x * r.y * r.z) as usize {
-            return Err("the voxel map does not match the resolution".into());
+    /// Checks the index's invariants for a grid of `resolution` cells; returns a description
+    /// of the first broken one.
+    pub fn validate(&self, resolution: UVec3) -> Result<(), String> {
+        if self.macro_resolution != CellIndex::macro_resolution_for(resolution) {
+            return Err("macrocell resolution does not match the grid".into());
         }
-        if self.cells.windows(2).any(|w| w[0].end != w[1].first)
-            || self.cells.first().is_some_and(|c| c.first != 0)
-        {
-            return Err("cells' blocks are not laid out in cell order".into());
+        if self.offsets.windows(2).any(|w| w[0] >= w[1]) {
+            return Err("an occupied cell is empty or offsets decrease".into());
         }
-        for (v, &m) in self.map.iter().enumerate() {
-            let Some(cell) = self.cells.get(m as usize) else {
-                return Err(format!("voxel {v} names cell {m} of {}", self.cells.len()));
-            };
-            let p = [
-                v as u32 % r.x,
-                (v as u32 / r.x) % r.y,
-                v as u32 / (r.x * r.y),
-            ];
-            if (0..3).any(|a| p[a] < cell.lo[a] as u32 || p[a] > cell.hi[a] as u32) {
-                return Err(format!("voxel {p:?} lies outside the box of its cell {m}"));
+        let counted: u32 = self
+            .records
+            .iter()
+            .flat_map(|r| r.bits)
+            .map(u64::count_ones)
+            .sum();
+        if counted as usize != self.occupied() || self.record_first.len() != self.records.len() {
+            return Err("records and offsets disagree".into());
+        }
+        let m = self.macro_resolution.as_ivec3();
+        for z in 0..m.z {
+            for y in 0..m.y {
+                for x in 0..m.x {
+                    let c = IVec3::new(x, y, z);
+                    let word = self.macro_cells[self.macro_index(c)];
+                    if word & EMPTY == 0 {
+                        if self.records[word as usize].bits.iter().all(|&b| b == 0) {
+                            return Err(format!("macrocell {c} has a record but no cell"));
+                        }
+                        continue;
+                    }
+                    let d = (word & !EMPTY) as i32;
+                    if d < 1 {
+                        return Err(format!("empty macrocell {c} has distance {d}"));
+                    }
+                    let lo = (c - (d - 1)).max(IVec3::ZERO);
+                    let hi = (c + (d - 1)).min(m - 1);
+                    for nz in lo.z..=hi.z {
+                        for ny in lo.y..=hi.y {
+                            for nx in lo.x..=hi.x {
+                                let n = IVec3::new(nx, ny, nz);
+                                if self.macro_cells[self.macro_index(n)] & EMPTY == 0 {
+                                    return Err(format!(
+                                        "macrocell {n} is occupied, within {} of {c}",
+                                        d - 1
+                                    ));
+                                }
+                            }
+                        }
+                    }
+                }
             }
         }
         Ok(())
     }
+}
+
+/// Index of a cell within its macrocell, from its coordinates there.
+#[inline(always)]
+fn local_index(l: IVec3) -> usize {
+    (l.x + (l.y << MACRO_SHIFT) + (l.z << (2 * MACRO_SHIFT))) as usize
 }

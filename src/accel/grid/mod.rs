@@ -13,7 +13,6 @@
 mod block;
 mod build;
 mod cells;
-mod merge;
 mod overlap;
 mod traverse;
 
@@ -22,7 +21,7 @@ pub use traverse::{TraversalCounts, TraversalStats};
 use glam::{UVec3, Vec3};
 
 use block::Block;
-use cells::CellIndex;
+use cells::{CellIndex, Lookup};
 
 use super::frame::GridFrame;
 use crate::scene::Aabb;
@@ -63,9 +62,9 @@ pub struct GridHit {
 /// Figures that describe a built grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridStats {
-    /// Voxels per axis.
+    /// Cells per axis.
     pub resolution: UVec3,
-    /// Cells (boxes of voxels) after merging.
+    /// Total cells.
     pub cells: usize,
     /// Triangles inserted (degenerate ones are left out).
     pub triangles: usize,
@@ -83,19 +82,24 @@ impl Grid {
         self.frame.bounds
     }
 
-    /// Voxels per axis.
+    /// Cells per axis.
     pub fn resolution(&self) -> UVec3 {
         self.frame.resolution
     }
 
-    /// Size of one voxel.
+    /// Size of one cell.
     pub fn cell_size(&self) -> Vec3 {
         self.frame.cell_size
     }
 
+    /// Number of cells.
+    fn cell_count(&self) -> usize {
+        self.frame.cell_count()
+    }
+
     /// Figures that describe this grid.
     pub fn stats(&self) -> GridStats {
-        let cells = self.cells.cells().len();
+        let cells = self.cell_count();
         let occupied = self.cells.occupied();
         GridStats {
             resolution: self.frame.resolution,
@@ -109,9 +113,15 @@ impl Grid {
         }
     }
 
+    /// Where cell `c` is counted in storage order.
+    #[inline]
+    fn storage_key(&self, c: UVec3) -> usize {
+        CellIndex::storage_key(CellIndex::macro_resolution_for(self.frame.resolution), c)
+    }
+
     /// Checks the structure's invariants; returns a description of the first broken one.
     pub fn validate(&self) -> Result<(), String> {
-        self.cells.validate()?;
+        self.cells.validate(self.frame.resolution)?;
         if self.cells.block_count() != self.blocks.len() {
             return Err("offsets and blocks disagree in length".into());
         }
@@ -121,32 +131,37 @@ impl Grid {
             return Err("a block is empty, or the blocks hold the wrong reference count".into());
         }
         let mut seen = vec![false; self.triangle_count];
-        for (k, cell) in self.cells.cells().iter().enumerate() {
-            let lo = Vec3::from_array(cell.lo.map(f32::from));
-            let hi = Vec3::from_array(cell.hi.map(f32::from)) + 1.0;
-            let size = self.frame.cell_size;
-            let bounds = Aabb {
-                min: self.frame.bounds.min + lo * size - size * 1e-3,
-                max: self.frame.bounds.min + hi * size + size * 1e-3,
-            };
-            let stored = cell
-                .blocks()
-                .flat_map(|b| (0..block::LANES).filter_map(move |l| self.blocks[b].get(l)));
-            for (triangle, id) in stored {
-                let id = id as usize;
-                let b = triangle.bounds();
-                if id >= self.triangle_count {
-                    return Err(format!(
-                        "cell {k} refers to triangle {id} of {}",
-                        self.triangle_count
-                    ));
+        for z in 0..self.frame.resolution.z {
+            for y in 0..self.frame.resolution.y {
+                for x in 0..self.frame.resolution.x {
+                    let c = UVec3::new(x, y, z);
+                    let Lookup::Blocks(range) = self.cells.lookup(c.as_ivec3()) else {
+                        continue;
+                    };
+                    let lo = self.frame.bounds.min + c.as_vec3() * self.frame.cell_size;
+                    let cell = Aabb {
+                        min: lo - self.frame.cell_size * 1e-3,
+                        max: lo + self.frame.cell_size * 1.001,
+                    };
+                    let stored = range
+                        .flat_map(|k| (0..block::LANES).filter_map(move |l| self.blocks[k].get(l)));
+                    for (triangle, id) in stored {
+                        let id = id as usize;
+                        let b = triangle.bounds();
+                        if id >= self.triangle_count {
+                            return Err(format!(
+                                "cell {c} refers to triangle {id} of {}",
+                                self.triangle_count
+                            ));
+                        }
+                        if b.max.cmplt(cell.min).any() || b.min.cmpgt(cell.max).any() {
+                            return Err(format!(
+                                "triangle {id} is stored in cell {c}, which it does not touch"
+                            ));
+                        }
+                        seen[id] = true;
+                    }
                 }
-                if b.max.cmplt(bounds.min).any() || b.min.cmpgt(bounds.max).any() {
-                    return Err(format!(
-                        "triangle {id} is stored in cell {k}, which it does not touch"
-                    ));
-                }
-                seen[id] = true;
             }
         }
         let in_cells = seen.iter().filter(|&&s| s).count();

@@ -1,12 +1,12 @@
-//! Ray traversal of the irregular grid (Pérard-Gayot, Kalojanov & Slusallek 2017): the
-//! walk looks up the cell of its current voxel, tests the cell's blocks eight triangles at
-//! a time, and leaves through the face of the cell's (expanded) box the ray reaches first,
-//! into the voxel beyond it; face parameters come from integer voxel coordinates as in the
-//! 3D-DDA of Amanatides & Woo (1987). A hit is accepted once it lies within a cell the walk
-//! has reached. A grid of one cell is not walked: its blocks are tested at once.
+//! Ray traversal: the 3D-DDA of Amanatides & Woo (1987), "A fast voxel traversal algorithm
+//! for ray tracing", over the two-level cell index ([`super::cells`]): an empty macrocell
+//! sends the walk past the whole empty cube around it in one step, an empty cell costs a
+//! bit test, and an occupied cell's blocks are tested eight triangles at a time. A grid of
+//! one cell is not walked: its blocks are tested at once.
 
 use glam::{IVec3, UVec3};
 
+use super::cells::{Lookup, MACRO_SHIFT};
 use super::{Grid, GridHit};
 use crate::accel::Ray;
 use crate::accel::frame::CellWalk;
@@ -90,7 +90,7 @@ impl Grid {
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
         let mut cells = self.occupied_cells(ray);
-        while let Some((range, limit)) = cells.next(stats, t_nearest) {
+        while let Some((range, limit)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
                 if let Some(hit) = block.nearest(ray, t_nearest) {
@@ -130,7 +130,7 @@ impl Grid {
     #[inline(always)]
     fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         let mut cells = self.occupied_cells(ray);
-        while let Some((range, _)) = cells.next(stats, ray.t_max) {
+        while let Some((range, _)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
                 if block.any(ray, ray.t_max) {
@@ -157,6 +157,60 @@ impl Grid {
             single_cell: single_cell && !self.blocks.is_empty(),
         }
     }
+
+    /// Moves the walk past the empty cube of macrocells around its current cell (of
+    /// Chebyshev radius `distance − 1`), to the first cell beyond it along the ray. False
+    /// when the ray leaves the grid first.
+    fn skip_empty(&self, walk: &mut CellWalk, ray: &Ray, distance: u32) -> bool {
+        let res = self.frame.resolution.as_ivec3();
+        let reach = distance.max(1) as i32 - 1;
+        let macrocell = walk.cell >> MACRO_SHIFT;
+        let macro_lo = ((macrocell - reach) << MACRO_SHIFT).max(IVec3::ZERO);
+        let macro_hi = (((macrocell + reach + 1) << MACRO_SHIFT) - 1).min(res - 1);
+        let mut axis = 0;
+        let mut t_exit = f32::INFINITY;
+        for a in 0..3 {
+            let face = if walk.step[a] > 0 {
+                macro_hi[a] + 1
+            } else {
+                macro_lo[a]
+            };
+            let t = walk.face_t(a, face);
+            if t < t_exit {
+                t_exit = t;
+                axis = a;
+            }
+        }
+        if t_exit >= walk.t_end {
+            return false;
+        }
+        let next = if walk.step[axis] > 0 {
+            macro_hi[axis] + 1
+        } else {
+            macro_lo[axis] - 1
+        };
+        if next < 0 || next >= res[axis] {
+            return false;
+        }
+        // The other axes: the cell under the exit point, kept within the empty cube and never
+        // behind the current cell, so rounding cannot move the walk backwards or sideways.
+        let p = ray.at(t_exit);
+        for a in 0..3 {
+            if a == axis {
+                walk.cell[a] = next;
+            } else if walk.step[a] != 0 {
+                let c = ((p[a] - self.frame.bounds.min[a]) * self.frame.inv_cell_size[a]).floor()
+                    as i32;
+                walk.cell[a] = if walk.step[a] > 0 {
+                    c.clamp(walk.cell[a], macro_hi[a])
+                } else {
+                    c.clamp(macro_lo[a], walk.cell[a])
+                };
+            }
+            walk.refresh(a);
+        }
+        true
+    }
 }
 
 /// The occupied cells along a ray, front to back (a cursor rather than an iterator, so the
@@ -173,15 +227,9 @@ struct OccupiedCells<'a> {
 
 impl OccupiedCells<'_> {
     /// Where the next occupied cell's blocks lie in `blocks`, and the largest hit parameter
-    /// that belongs to the cell (the last cell takes all up to the grid's end); `None` when
-    /// the ray leaves the grid, or when a hit at `t_nearest` already found is the nearest
-    /// (it lies within a cell the walk has reached).
+    /// that belongs to the cell (the last cell takes all up to the grid's end).
     #[inline(always)]
-    fn next(
-        &mut self,
-        stats: &mut impl TraversalStats,
-        t_nearest: f32,
-    ) -> Option<(std::ops::Range<usize>, f32)> {
+    fn next(&mut self, stats: &mut impl TraversalStats) -> Option<(std::ops::Range<usize>, f32)> {
         let grid = self.grid;
         if self.single_cell {
             self.single_cell = false;
@@ -189,64 +237,30 @@ impl OccupiedCells<'_> {
             return Some((0..grid.blocks.len(), f32::INFINITY));
         }
         let walk = self.walk.as_mut()?;
-        let frame = &grid.frame;
-        let resolution = frame.resolution.as_ivec3();
         loop {
             stats.visit_cell();
-            let cell = grid.cells.cell_at(walk.cell);
-            let (lo, hi) = (
-                IVec3::from_array(cell.lo.map(i32::from)),
-                IVec3::from_array(cell.hi.map(i32::from)),
-            );
-            // The ray leaves the cell's box by the face it reaches first.
-            let mut axis = 0;
-            let mut t_exit = f32::INFINITY;
-            for a in 0..3 {
-                let face = if walk.step[a] > 0 { hi[a] + 1 } else { lo[a] };
-                let t = walk.face_t(a, face);
-                if t < t_exit {
-                    t_exit = t;
-                    axis = a;
+            let range = match grid.cells.lookup(walk.cell) {
+                Lookup::EmptyMacrocell { distance } => {
+                    if !grid.skip_empty(walk, self.ray, distance) {
+                        self.walk = None;
+                        return None;
+                    }
+                    continue;
                 }
-            }
-            let next = if walk.step[axis] > 0 {
-                hi[axis] + 1
-            } else {
-                lo[axis] - 1
+                Lookup::EmptyCell => None,
+                Lookup::Blocks(range) => {
+                    stats.visit_occupied();
+                    Some(range)
+                }
             };
-            let last = t_exit >= walk.t_end || next < 0 || next >= resolution[axis];
-            let limit = if last { walk.t_end } else { t_exit };
-            let blocks = cell.blocks();
-            let occupied = !blocks.is_empty();
-            if occupied {
-                stats.visit_occupied();
-            }
-            if last {
+            let exit = walk.exit();
+            if exit.last {
                 self.walk = None;
-                return occupied.then_some((blocks, limit));
+                return range.map(|r| (r, exit.t));
             }
-            // The voxel beyond the exit face: on the other axes, the one under the exit
-            // point, kept within the box and never behind the current voxel, so rounding
-            // cannot move the walk backwards or sideways (each step leaves the box).
-            let p = self.ray.at(t_exit);
-            for a in 0..3 {
-                if a == axis {
-                    walk.cell[a] = next;
-                } else if walk.step[a] != 0 {
-                    let c = ((p[a] - frame.bounds.min[a]) * frame.inv_cell_size[a]).floor() as i32;
-                    walk.cell[a] = if walk.step[a] > 0 {
-                        c.clamp(walk.cell[a], hi[a])
-                    } else {
-                        c.clamp(lo[a], walk.cell[a])
-                    };
-                }
-            }
-            if occupied {
-                return Some((blocks, limit));
-            }
-            if t_nearest <= limit {
-                self.walk = None;
-                return None;
+            walk.advance(exit);
+            if let Some(range) = range {
+                return Some((range, exit.t));
             }
         }
     }
