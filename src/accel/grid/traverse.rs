@@ -155,6 +155,7 @@ impl Grid {
             ray,
             walk,
             single_cell: single_cell && !self.blocks.is_empty(),
+            ahead: None,
         }
     }
 
@@ -223,19 +224,47 @@ struct OccupiedCells<'a> {
     /// True until the one cell of a single-cell grid has been given out: such a grid is not
     /// walked (a few triangles are tested faster all at once than found by a walk).
     single_cell: bool,
+    /// The occupied cell after the one given out last, found ahead of time; `None` before
+    /// the first is given out.
+    ahead: Option<Option<(std::ops::Range<usize>, f32)>>,
 }
 
 impl OccupiedCells<'_> {
     /// Where the next occupied cell's blocks lie in `blocks`, and the largest hit parameter
     /// that belongs to the cell (the last cell takes all up to the grid's end).
+    ///
+    /// The walk runs one occupied cell ahead and starts loading that cell's first block, so
+    /// the block's memory latency (the largest single cost of a walk) overlaps the tests of
+    /// the cell given out now; a step costs little beside it.
     #[inline(always)]
     fn next(&mut self, stats: &mut impl TraversalStats) -> Option<(std::ops::Range<usize>, f32)> {
         let grid = self.grid;
         if self.single_cell {
             self.single_cell = false;
+            stats.visit_occupied();
             // Every hit belongs to the one cell.
             return Some((0..grid.blocks.len(), f32::INFINITY));
         }
+        let current = match self.ahead.take() {
+            Some(ahead) => ahead,
+            None => self.find_next(stats),
+        }?;
+        let ahead = self.find_next(stats);
+        if let Some((blocks, _)) = &ahead {
+            grid.blocks[blocks.start].prefetch();
+        }
+        self.ahead = Some(ahead);
+        stats.visit_occupied();
+        Some(current)
+    }
+
+    /// The walk on to the next occupied cell: its blocks and hit limit.
+    #[inline(always)]
+    fn find_next(
+        &mut self,
+        stats: &mut impl TraversalStats,
+    ) -> Option<(std::ops::Range<usize>, f32)> {
+        let grid = self.grid;
         let walk = self.walk.as_mut()?;
         loop {
             stats.visit_cell();
@@ -248,10 +277,7 @@ impl OccupiedCells<'_> {
                     continue;
                 }
                 Lookup::EmptyCell => None,
-                Lookup::Blocks(range) => {
-                    stats.visit_occupied();
-                    Some(range)
-                }
+                Lookup::Blocks(range) => Some(range),
             };
             let exit = walk.exit();
             if exit.last {
