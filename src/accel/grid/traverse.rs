@@ -161,7 +161,9 @@ impl Grid {
 
     /// Moves the walk past the empty cube of macrocells around its current cell (of
     /// Chebyshev radius `distance − 1`), to the first cell beyond it along the ray. False
-    /// when the ray leaves the grid first.
+    /// when the ray leaves the grid first. Inlined into the walk, so that it is compiled
+    /// with the walk's instruction set (otherwise `floor` is a call into libm).
+    #[inline(always)]
     fn skip_empty(&self, walk: &mut CellWalk, ray: &Ray, distance: u32) -> bool {
         let res = self.frame.resolution.as_ivec3();
         let reach = distance.max(1) as i32 - 1;
