@@ -2,7 +2,7 @@
 //! near-cubic cells, the cell under a point, and the 3D-DDA walk of Amanatides & Woo (1987),
 //! "A fast voxel traversal algorithm for ray tracing", through the cells a ray crosses.
 
-use glam::{IVec3, UVec3, Vec3};
+use glam::{IVec3, UVec3, Vec3, Vec3A};
 
 use super::Ray;
 use crate::scene::Aabb;
@@ -74,6 +74,9 @@ impl GridFrame {
     }
 
     /// Clips the ray to the box and finds the first cell; `None` when it misses the box.
+    /// Inlined, so that it is compiled with the caller's instruction set (otherwise
+    /// `floor` is a call into libm).
+    #[inline(always)]
     pub fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
         if !(ray.origin.is_finite() && ray.direction.is_finite()) {
             return None;
@@ -98,98 +101,100 @@ impl GridFrame {
             step_of(ray.direction.y),
             step_of(ray.direction.z),
         );
+        // An axis the ray is parallel to gets slope 0 and offset ∞: its faces lie at ∞.
+        let moving = step.cmpne(IVec3::ZERO);
+        let slope = Vec3::select(moving, self.cell_size * inv, Vec3::ZERO);
+        let offset = Vec3::select(moving, t0, Vec3::INFINITY);
         let mut walk = CellWalk {
             cell,
             step,
-            slope: self.cell_size * inv,
-            offset: t0,
-            t_next: Vec3::INFINITY,
+            far_side: IVec3::select(step.cmpgt(IVec3::ZERO), IVec3::ONE, IVec3::ZERO),
+            step_f: step.as_vec3().into(),
+            face: Vec3A::ZERO,
+            slope: slope.into(),
+            offset: offset.into(),
+            t_next: Vec3A::INFINITY,
             t_end,
-            resolution: self.resolution.as_ivec3(),
+            resolution: self.resolution,
         };
-        for axis in 0..3 {
-            walk.refresh(axis);
-        }
+        walk.refresh();
         Some(walk)
     }
 }
 
-/// Where the walk leaves the current cell.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct CellExit {
-    /// The axis whose face the ray crosses first.
-    pub axis: usize,
-    /// Ray parameter at that face.
-    pub t: f32,
-    /// True when no cell follows (the ray leaves the grid or reaches its end here).
-    pub last: bool,
-}
-
 /// The walk of one ray through the cells it crosses, front to back.
+///
+/// Written without branches on the axis (the axis of each step is as good as random for
+/// bounce rays, so a branch on it would be mispredicted about every other step) and
+/// without indexing vectors by a run-time axis, so the state stays in registers.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CellWalk {
     /// Current cell.
     pub cell: IVec3,
     /// −1, 0 or +1 per axis.
     pub step: IVec3,
-    /// The ray crosses the plane of cell face `k` on axis `a` at `t = slope[a]·k + offset[a]`:
-    /// face distances come from integer coordinates, so no error accumulates.
-    slope: Vec3,
-    offset: Vec3,
+    /// 1 on axes the ray moves up, else 0: the cell's far face is `cell + far_side`.
+    far_side: IVec3,
+    /// `step` as floats.
+    step_f: Vec3A,
+    /// The current cell's far face per axis, `cell + far_side`, as floats (whole numbers,
+    /// so exact): a step adds to it and the exit distances follow in one multiply-add,
+    /// without an integer-to-float conversion in the chain from one step to the next.
+    face: Vec3A,
+    /// The ray crosses the plane of cell face `k` on axis `a` at `t = slope[a]·k + offset[a]`
+    /// (∞ for an axis the ray is parallel to): face distances come from whole-number face
+    /// coordinates, so no error accumulates.
+    slope: Vec3A,
+    offset: Vec3A,
     /// Ray parameter at which the ray leaves the current cell, per axis.
-    t_next: Vec3,
+    t_next: Vec3A,
     /// Ray parameter at which the ray leaves the grid (or reaches `t_max`).
     pub t_end: f32,
-    resolution: IVec3,
+    resolution: UVec3,
 }
 
 impl CellWalk {
     /// Parameter of the plane of cell face `face` on `axis` (∞ if the ray is parallel to it).
-    #[inline]
+    #[inline(always)]
     pub fn face_t(&self, axis: usize, face: i32) -> f32 {
-        if self.step[axis] == 0 {
-            f32::INFINITY
-        } else {
-            self.slope[axis] * face as f32 + self.offset[axis]
-        }
+        self.slope[axis] * face as f32 + self.offset[axis]
     }
 
-    /// Recomputes where the ray leaves the current cell on `axis`.
-    #[inline]
-    pub fn refresh(&mut self, axis: usize) {
-        let far_face = self.cell[axis] + i32::from(self.step[axis] > 0);
-        self.t_next[axis] = self.face_t(axis, far_face);
+    /// Recomputes where the ray leaves the current cell, on every axis.
+    #[inline(always)]
+    pub fn refresh(&mut self) {
+        self.face = (self.cell + self.far_side).as_vec3().into();
+        self.t_next = self.slope * self.face + self.offset;
     }
 
-    /// Where the ray leaves the current cell; only hits up to `t` belong to it (up to
-    /// `t_end` in the last cell).
-    #[inline]
-    pub fn exit(&self) -> CellExit {
+    /// Leaves the current cell: returns the largest ray parameter whose hits belong to it
+    /// (`t_end` in the last cell), and moves on to the next cell; false as second value
+    /// when there is none (the ray leaves the grid or reaches its end here).
+    #[inline(always)]
+    pub fn advance(&mut self) -> (f32, bool) {
         let t = self.t_next;
-        let axis = if t.x <= t.y && t.x <= t.z {
-            0
-        } else if t.y <= t.z {
-            1
-        } else {
-            2
-        };
-        let next = self.cell[axis] + self.step[axis];
-        let last = self.step[axis] == 0
-            || next < 0
-            || next >= self.resolution[axis]
-            || t[axis] >= self.t_end;
-        CellExit {
-            axis,
-            t: if last { self.t_end } else { t[axis] },
-            last,
+        // The axis whose face comes first (x before y before z on ties), as 0/1 masks.
+        let on_x = (t.x <= t.y) & (t.x <= t.z);
+        let on_y = !on_x & (t.y <= t.z);
+        let on_z = !on_x & !on_y;
+        let t_exit = t.x.min(t.y).min(t.z);
+        let chosen = IVec3::new(i32::from(on_x), i32::from(on_y), i32::from(on_z));
+        let next = self.cell + chosen * self.step;
+        // Outside on some axis (a negative coordinate wraps to a huge unsigned one), or a
+        // face at or past the end: this cell was the last.
+        let outside = next.as_uvec3().cmpge(self.resolution).any();
+        if outside | (t_exit >= self.t_end) {
+            return (self.t_end, false);
         }
-    }
-
-    /// Moves to the next cell through the face `exit` found.
-    #[inline]
-    pub fn advance(&mut self, exit: CellExit) {
-        self.cell[exit.axis] += self.step[exit.axis];
-        self.refresh(exit.axis);
+        self.cell = next;
+        let chosen_f = Vec3A::select(
+            glam::BVec3A::new(on_x, on_y, on_z),
+            self.step_f,
+            Vec3A::ZERO,
+        );
+        self.face += chosen_f;
+        self.t_next = self.slope * self.face + self.offset;
+        (t_exit, true)
     }
 }
 
@@ -274,13 +279,13 @@ mod tests {
         let mut walk = frame.start_walk(&ray).unwrap();
         let mut cells = vec![walk.cell];
         loop {
-            let exit = walk.exit();
-            if exit.last {
-                assert_eq!(exit.t, walk.t_end);
+            let x = walk.cell.x;
+            let (t, more) = walk.advance();
+            if !more {
+                assert_eq!(t, walk.t_end);
                 break;
             }
-            assert_eq!(exit.t, (walk.cell.x + 2) as f32);
-            walk.advance(exit);
+            assert_eq!(t, (x + 2) as f32);
             cells.push(walk.cell);
         }
         assert_eq!(

@@ -103,16 +103,15 @@ impl InstanceGrid {
             return;
         };
         loop {
-            let exit = walk.exit();
             let c = self.frame.cell_index(walk.cell.as_uvec3());
             let ids = &self.ids[self.offsets[c] as usize..self.offsets[c + 1] as usize];
-            if !ids.is_empty() && visit(ids, exit.t) {
+            let (limit, more) = walk.advance();
+            if !ids.is_empty() && visit(ids, limit) {
                 return;
             }
-            if exit.last {
+            if !more {
                 return;
             }
-            walk.advance(exit);
         }
     }
 

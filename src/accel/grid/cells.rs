@@ -13,6 +13,9 @@ use std::collections::VecDeque;
 use std::ops::Range;
 
 use glam::{IVec3, UVec3};
+use rayon::prelude::*;
+
+use super::gaps::Gaps;
 
 /// A macrocell is 2^MACRO_SHIFT cells along each axis.
 pub(super) const MACRO_SHIFT: i32 = 3;
@@ -36,8 +39,9 @@ pub(super) enum Lookup {
     /// The cell's macrocell is empty, and so is every macrocell within Chebyshev distance
     /// `distance − 1` of it.
     EmptyMacrocell { distance: u32 },
-    /// The cell is empty (its macrocell is not).
-    EmptyCell,
+    /// The cell is empty (its macrocell is not), and so is every cell within Chebyshev
+    /// distance `gap − 1` of it.
+    EmptyCell { gap: u32 },
     /// The cell's blocks.
     Blocks(Range<usize>),
 }
@@ -50,6 +54,8 @@ pub(super) struct CellIndex {
     /// Per macrocell: its record's index, or `EMPTY | distance`.
     macro_cells: Vec<u32>,
     records: Vec<Record>,
+    /// Per record, each cell's distance to the nearest occupied cell.
+    gaps: Vec<Gaps>,
     /// Number of the first occupied cell of each record.
     record_first: Vec<u32>,
     /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes the blocks.
@@ -103,6 +109,7 @@ impl CellIndex {
         }
         index.offsets.push(total);
         index.fill_distances();
+        index.fill_gaps();
         index
     }
 
@@ -151,6 +158,38 @@ impl CellIndex {
         }
     }
 
+    /// Each record's cell gaps ([`Gaps`]), in parallel over records.
+    fn fill_gaps(&mut self) {
+        let m = self.macro_resolution.as_ivec3();
+        let mut at = vec![IVec3::ZERO; self.records.len()];
+        for z in 0..m.z {
+            for y in 0..m.y {
+                for x in 0..m.x {
+                    let c = IVec3::new(x, y, z);
+                    let word = self.macro_cells[self.macro_index(c)];
+                    if word & EMPTY == 0 {
+                        at[word as usize] = c;
+                    }
+                }
+            }
+        }
+        let index = &*self;
+        let gaps = at
+            .par_iter()
+            .map(|&c| {
+                Gaps::of(|dx, dy, dz| {
+                    let n = c + IVec3::new(dx, dy, dz);
+                    if n.cmplt(IVec3::ZERO).any() || n.cmpge(m).any() {
+                        return None;
+                    }
+                    let word = index.macro_cells[index.macro_index(n)];
+                    (word & EMPTY == 0).then(|| index.records[word as usize].bits)
+                })
+            })
+            .collect();
+        self.gaps = gaps;
+    }
+
     #[inline]
     fn macro_index(&self, m: IVec3) -> usize {
         let r = self.macro_resolution;
@@ -171,7 +210,9 @@ impl CellIndex {
         let bits = record.bits[l >> 6];
         let bit = 1u64 << (l & 63);
         if bits & bit == 0 {
-            return Lookup::EmptyCell;
+            return Lookup::EmptyCell {
+                gap: self.gaps[word as usize].get(l),
+            };
         }
         let before: u32 = record.bits[..l >> 6].iter().map(|w| w.count_ones()).sum();
         let k =
@@ -193,6 +234,7 @@ impl CellIndex {
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(self.macro_cells.as_slice())
             + std::mem::size_of_val(self.records.as_slice())
+            + std::mem::size_of_val(self.gaps.as_slice())
             + std::mem::size_of_val(self.record_first.as_slice())
             + std::mem::size_of_val(self.offsets.as_slice())
     }
@@ -245,6 +287,77 @@ impl CellIndex {
                                 }
                             }
                         }
+                    }
+                }
+            }
+        }
+        self.validate_gaps(resolution)
+    }
+}
+
+impl CellIndex {
+    /// Checks every stored gap against a count of occupied cells in boxes, from a table of
+    /// sums over the whole grid (Crow 1984): the cube of cells within `gap − 1` holds
+    /// none, and (below the cap) the cube within `gap` holds one.
+    fn validate_gaps(&self, resolution: UVec3) -> Result<(), String> {
+        if self.gaps.len() != self.records.len() {
+            return Err("gaps and records disagree in length".into());
+        }
+        let r = resolution.as_ivec3();
+        let (sx, sy) = (r.x as usize + 1, r.y as usize + 1);
+        let at = |x: i32, y: i32, z: i32| x as usize + sx * (y as usize + sy * z as usize);
+        let occupied = |c: IVec3| {
+            !matches!(
+                self.lookup(c),
+                Lookup::EmptyMacrocell { .. } | Lookup::EmptyCell { .. }
+            )
+        };
+        let mut sums = vec![0u32; sx * sy * (r.z as usize + 1)];
+        for z in 0..r.z {
+            for y in 0..r.y {
+                for x in 0..r.x {
+                    let own = u32::from(occupied(IVec3::new(x, y, z)));
+                    sums[at(x + 1, y + 1, z + 1)] = own
+                        .wrapping_add(sums[at(x, y + 1, z + 1)])
+                        .wrapping_add(sums[at(x + 1, y, z + 1)])
+                        .wrapping_add(sums[at(x + 1, y + 1, z)])
+                        .wrapping_sub(sums[at(x, y, z + 1)])
+                        .wrapping_sub(sums[at(x, y + 1, z)])
+                        .wrapping_sub(sums[at(x + 1, y, z)])
+                        .wrapping_add(sums[at(x, y, z)]);
+                }
+            }
+        }
+        // Occupied cells within Chebyshev distance `reach` of `c`.
+        let around = |c: IVec3, reach: i32| {
+            let lo = (c - reach).max(IVec3::ZERO);
+            let hi = (c + reach + 1).min(r);
+            sums[at(hi.x, hi.y, hi.z)]
+                .wrapping_sub(sums[at(lo.x, hi.y, hi.z)])
+                .wrapping_sub(sums[at(hi.x, lo.y, hi.z)])
+                .wrapping_sub(sums[at(hi.x, hi.y, lo.z)])
+                .wrapping_add(sums[at(lo.x, lo.y, hi.z)])
+                .wrapping_add(sums[at(lo.x, hi.y, lo.z)])
+                .wrapping_add(sums[at(hi.x, lo.y, lo.z)])
+                .wrapping_sub(sums[at(lo.x, lo.y, lo.z)])
+        };
+        for z in 0..r.z {
+            for y in 0..r.y {
+                for x in 0..r.x {
+                    let c = IVec3::new(x, y, z);
+                    let Lookup::EmptyCell { gap } = self.lookup(c) else {
+                        continue;
+                    };
+                    let gap = gap as i32;
+                    if gap < 1 || around(c, gap - 1) != 0 {
+                        return Err(format!(
+                            "cell {c} has gap {gap}, but an occupied cell is nearer"
+                        ));
+                    }
+                    if gap <= i32::from(super::gaps::MAX_RADIUS) && around(c, gap) == 0 {
+                        return Err(format!(
+                            "cell {c} has gap {gap}, but no occupied cell is that near"
+                        ));
                     }
                 }
             }

@@ -13,6 +13,7 @@
 mod block;
 mod build;
 mod cells;
+mod gaps;
 mod overlap;
 mod traverse;
 

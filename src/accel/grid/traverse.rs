@@ -161,23 +161,39 @@ impl Grid {
 
     /// Moves the walk past the empty cube of macrocells around its current cell (of
     /// Chebyshev radius `distance − 1`), to the first cell beyond it along the ray. False
-    /// when the ray leaves the grid first. Inlined into the walk, so that it is compiled
-    /// with the walk's instruction set (otherwise `floor` is a call into libm).
+    /// when the ray leaves the grid first.
     #[inline(always)]
-    fn skip_empty(&self, walk: &mut CellWalk, ray: &Ray, distance: u32) -> bool {
+    fn skip_empty_macrocells(&self, walk: &mut CellWalk, ray: &Ray, distance: u32) -> bool {
         let res = self.frame.resolution.as_ivec3();
         let reach = distance.max(1) as i32 - 1;
         let macrocell = walk.cell >> MACRO_SHIFT;
-        let macro_lo = ((macrocell - reach) << MACRO_SHIFT).max(IVec3::ZERO);
-        let macro_hi = (((macrocell + reach + 1) << MACRO_SHIFT) - 1).min(res - 1);
+        let lo = ((macrocell - reach) << MACRO_SHIFT).max(IVec3::ZERO);
+        let hi = (((macrocell + reach + 1) << MACRO_SHIFT) - 1).min(res - 1);
+        self.skip_cube(walk, ray, lo, hi)
+    }
+
+    /// Moves the walk past the empty cube of cells around its current cell (of Chebyshev
+    /// radius `gap − 1`, `gap` ≥ 2). False when the ray leaves the grid first.
+    #[inline(always)]
+    fn skip_empty_cells(&self, walk: &mut CellWalk, ray: &Ray, gap: u32) -> bool {
+        let res = self.frame.resolution.as_ivec3();
+        let reach = gap as i32 - 1;
+        let lo = (walk.cell - reach).max(IVec3::ZERO);
+        let hi = (walk.cell + reach).min(res - 1);
+        self.skip_cube(walk, ray, lo, hi)
+    }
+
+    /// Moves the walk out of the empty box of cells `lo..=hi` (which holds the current
+    /// cell) to the first cell beyond it along the ray. False when the ray leaves the grid
+    /// first. Inlined into the walk, so that it is compiled with the walk's instruction set
+    /// (otherwise `floor` is a call into libm).
+    #[inline(always)]
+    fn skip_cube(&self, walk: &mut CellWalk, ray: &Ray, lo: IVec3, hi: IVec3) -> bool {
+        let res = self.frame.resolution.as_ivec3();
         let mut axis = 0;
         let mut t_exit = f32::INFINITY;
         for a in 0..3 {
-            let face = if walk.step[a] > 0 {
-                macro_hi[a] + 1
-            } else {
-                macro_lo[a]
-            };
+            let face = if walk.step[a] > 0 { hi[a] + 1 } else { lo[a] };
             let t = walk.face_t(a, face);
             if t < t_exit {
                 t_exit = t;
@@ -188,14 +204,14 @@ impl Grid {
             return false;
         }
         let next = if walk.step[axis] > 0 {
-            macro_hi[axis] + 1
+            hi[axis] + 1
         } else {
-            macro_lo[axis] - 1
+            lo[axis] - 1
         };
         if next < 0 || next >= res[axis] {
             return false;
         }
-        // The other axes: the cell under the exit point, kept within the empty cube and never
+        // The other axes: the cell under the exit point, kept within the empty box and never
         // behind the current cell, so rounding cannot move the walk backwards or sideways.
         let p = ray.at(t_exit);
         for a in 0..3 {
@@ -205,13 +221,13 @@ impl Grid {
                 let c = ((p[a] - self.frame.bounds.min[a]) * self.frame.inv_cell_size[a]).floor()
                     as i32;
                 walk.cell[a] = if walk.step[a] > 0 {
-                    c.clamp(walk.cell[a], macro_hi[a])
+                    c.clamp(walk.cell[a], hi[a])
                 } else {
-                    c.clamp(macro_lo[a], walk.cell[a])
+                    c.clamp(lo[a], walk.cell[a])
                 };
             }
-            walk.refresh(a);
         }
+        walk.refresh();
         true
     }
 }
@@ -272,23 +288,31 @@ impl OccupiedCells<'_> {
             stats.visit_cell();
             let range = match grid.cells.lookup(walk.cell) {
                 Lookup::EmptyMacrocell { distance } => {
-                    if !grid.skip_empty(walk, self.ray, distance) {
+                    if !grid.skip_empty_macrocells(walk, self.ray, distance) {
                         self.walk = None;
                         return None;
                     }
                     continue;
                 }
-                Lookup::EmptyCell => None,
+                // A cell next to an occupied one (gap 1) is left by an ordinary step: cheaper
+                // than leaving a cube of one cell.
+                Lookup::EmptyCell { gap } if gap >= 2 => {
+                    if !grid.skip_empty_cells(walk, self.ray, gap) {
+                        self.walk = None;
+                        return None;
+                    }
+                    continue;
+                }
+                Lookup::EmptyCell { .. } => None,
                 Lookup::Blocks(range) => Some(range),
             };
-            let exit = walk.exit();
-            if exit.last {
+            let (limit, more) = walk.advance();
+            if !more {
                 self.walk = None;
-                return range.map(|r| (r, exit.t));
+                return range.map(|r| (r, limit));
             }
-            walk.advance(exit);
             if let Some(range) = range {
-                return Some((range, exit.t));
+                return Some((range, limit));
             }
         }
     }
