@@ -56,8 +56,9 @@ pub(super) struct CellIndex {
     records: Vec<Record>,
     /// Per record, each cell's distance to the nearest occupied cell.
     gaps: Vec<Gaps>,
-    /// Number of the first occupied cell of each record.
-    record_first: Vec<u32>,
+    /// Per record and per word of its bits, the number of the word's first occupied cell
+    /// (so an occupied cell's number is one popcount away, with no loop over words).
+    ranks: Vec<[u32; MACRO_CELLS / 64]>,
     /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes the blocks.
     offsets: Vec<u32>,
 }
@@ -97,8 +98,11 @@ impl CellIndex {
             }
             let mut record = Record::default();
             index.macro_cells[mi] = index.records.len() as u32;
-            index.record_first.push(index.offsets.len() as u32);
+            let mut ranks = [0u32; MACRO_CELLS / 64];
             for (l, &n) in cells.iter().enumerate() {
+                if l & 63 == 0 {
+                    ranks[l >> 6] = index.offsets.len() as u32;
+                }
                 if n > 0 {
                     record.bits[l >> 6] |= 1 << (l & 63);
                     index.offsets.push(total);
@@ -106,6 +110,7 @@ impl CellIndex {
                 }
             }
             index.records.push(record);
+            index.ranks.push(ranks);
         }
         index.offsets.push(total);
         index.fill_distances();
@@ -214,9 +219,7 @@ impl CellIndex {
                 gap: self.gaps[word as usize].get(l),
             };
         }
-        let before: u32 = record.bits[..l >> 6].iter().map(|w| w.count_ones()).sum();
-        let k =
-            (self.record_first[word as usize] + before + (bits & (bit - 1)).count_ones()) as usize;
+        let k = (self.ranks[word as usize][l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
         Lookup::Blocks(self.offsets[k] as usize..self.offsets[k + 1] as usize)
     }
 
@@ -235,7 +238,7 @@ impl CellIndex {
         std::mem::size_of_val(self.macro_cells.as_slice())
             + std::mem::size_of_val(self.records.as_slice())
             + std::mem::size_of_val(self.gaps.as_slice())
-            + std::mem::size_of_val(self.record_first.as_slice())
+            + std::mem::size_of_val(self.ranks.as_slice())
             + std::mem::size_of_val(self.offsets.as_slice())
     }
 
@@ -254,7 +257,7 @@ impl CellIndex {
             .flat_map(|r| r.bits)
             .map(u64::count_ones)
             .sum();
-        if counted as usize != self.occupied() || self.record_first.len() != self.records.len() {
+        if counted as usize != self.occupied() || self.ranks.len() != self.records.len() {
             return Err("records and offsets disagree".into());
         }
         let m = self.macro_resolution.as_ivec3();

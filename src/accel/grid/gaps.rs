@@ -68,27 +68,30 @@ impl Gaps {
             let l = x + SIDE * (y + SIDE * z);
             gaps[l >> 1] |= d << ((l & 1) * 4);
         };
+        let mut scratch = Scratch::default();
         for d in 1..=MAX_RADIUS {
-            rows = dilate(&rows);
+            if known.iter().flatten().all(|&row| row == 0xff) {
+                break;
+            }
+            dilate(&mut rows, d as usize, &mut scratch);
             for z in 0..SIDE {
                 for y in 0..SIDE {
                     let reached = central(rows[SIDE + z][SIDE + y]);
-                    let new = reached & !known[z][y];
+                    let mut new = reached & !known[z][y];
                     known[z][y] |= new;
-                    for x in 0..SIDE {
-                        if new & (1 << x) != 0 {
-                            set(x, y, z, d);
-                        }
+                    while new != 0 {
+                        set(new.trailing_zeros() as usize, y, z, d);
+                        new &= new - 1;
                     }
                 }
             }
         }
         for (z, plane) in known.iter().enumerate() {
             for (y, &row) in plane.iter().enumerate() {
-                for x in 0..SIDE {
-                    if row & (1 << x) == 0 {
-                        set(x, y, z, MAX_RADIUS + 1);
-                    }
+                let mut far = !row & 0xff;
+                while far != 0 {
+                    set(far.trailing_zeros() as usize, y, z, MAX_RADIUS + 1);
+                    far &= far - 1;
                 }
             }
         }
@@ -101,30 +104,46 @@ fn central(row: u32) -> u32 {
     (row >> SIDE) & 0xff
 }
 
-/// The window grown by one cell in every direction (26 neighbours): along x by shifting
-/// each row, then along y and z by or-ing neighbouring rows.
-fn dilate(rows: &[[u32; WINDOW]; WINDOW]) -> [[u32; WINDOW]; WINDOW] {
+/// Work arrays of [`dilate`], kept between its calls.
+struct Scratch {
+    x: [[u32; WINDOW]; WINDOW],
+    xy: [[u32; WINDOW]; WINDOW],
+}
+
+impl Default for Scratch {
+    fn default() -> Scratch {
+        Scratch {
+            x: [[0; WINDOW]; WINDOW],
+            xy: [[0; WINDOW]; WINDOW],
+        }
+    }
+}
+
+/// The window grown by one cell in every direction (26 neighbours), for the `d`-th time:
+/// along x by shifting each row, then along y and z by or-ing neighbouring rows. Only the
+/// rows `d..WINDOW − d` (in y and z) are brought up to date: the central macrocell's
+/// distances up to `MAX_RADIUS` depend on no others in the dilations still to come, and
+/// those rows' neighbours were up to date after the previous one.
+fn dilate(rows: &mut [[u32; WINDOW]; WINDOW], d: usize, scratch: &mut Scratch) {
     let mask = (1u32 << WINDOW) - 1;
-    let mut x = [[0u32; WINDOW]; WINDOW];
-    for z in 0..WINDOW {
-        for y in 0..WINDOW {
+    let (lo, hi) = (d, WINDOW - d);
+    let (outer_lo, outer_hi) = (lo - 1, hi + 1);
+    for z in outer_lo..outer_hi {
+        for y in outer_lo..outer_hi {
             let r = rows[z][y];
-            x[z][y] = (r | (r << 1) | (r >> 1)) & mask;
+            scratch.x[z][y] = (r | (r << 1) | (r >> 1)) & mask;
         }
     }
-    let mut xy = [[0u32; WINDOW]; WINDOW];
-    for z in 0..WINDOW {
-        for y in 0..WINDOW {
-            xy[z][y] = x[z][y] | x[z][y.saturating_sub(1)] | x[z][(y + 1).min(WINDOW - 1)];
+    for z in outer_lo..outer_hi {
+        for y in lo..hi {
+            scratch.xy[z][y] = scratch.x[z][y - 1] | scratch.x[z][y] | scratch.x[z][y + 1];
         }
     }
-    let mut xyz = [[0u32; WINDOW]; WINDOW];
-    for z in 0..WINDOW {
-        for y in 0..WINDOW {
-            xyz[z][y] = xy[z][y] | xy[z.saturating_sub(1)][y] | xy[(z + 1).min(WINDOW - 1)][y];
+    for z in lo..hi {
+        for y in lo..hi {
+            rows[z][y] = scratch.xy[z - 1][y] | scratch.xy[z][y] | scratch.xy[z + 1][y];
         }
     }
-    xyz
 }
 
 #[cfg(test)]
