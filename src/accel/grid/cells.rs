@@ -36,9 +36,9 @@ struct Record {
 
 /// What the index says about one cell.
 pub(super) enum Lookup {
-    /// The cell's macrocell is empty, and so is every macrocell within Chebyshev distance
-    /// `distance − 1` of it.
-    EmptyMacrocell { distance: u32 },
+    /// The cell's macrocell is empty (its distance to an occupied one is
+    /// [`CellIndex::macrocell_of`]'s answer).
+    EmptyMacrocell,
     /// The cell is empty (its macrocell is not), and so is every cell within Chebyshev
     /// distance `gap − 1` of it.
     EmptyCell { gap: u32 },
@@ -204,22 +204,36 @@ impl CellIndex {
     /// What the index says about cell `c` (inside the grid).
     #[inline(always)]
     pub fn lookup(&self, c: IVec3) -> Lookup {
+        match self.macrocell_of(c) {
+            Err(_) => Lookup::EmptyMacrocell,
+            Ok(record) => self.lookup_in(record, c),
+        }
+    }
+
+    /// The record of cell `c`'s macrocell, or (`Err`) the macrocell's distance to the
+    /// nearest occupied one when it is empty.
+    #[inline(always)]
+    pub fn macrocell_of(&self, c: IVec3) -> Result<usize, u32> {
         let word = self.macro_cells[self.macro_index(c >> MACRO_SHIFT)];
         if word & EMPTY != 0 {
-            return Lookup::EmptyMacrocell {
-                distance: word & !EMPTY,
-            };
+            Err(word & !EMPTY)
+        } else {
+            Ok(word as usize)
         }
-        let record = &self.records[word as usize];
+    }
+
+    /// What record `record` says about its cell `c`: `EmptyCell` or `Blocks`.
+    #[inline(always)]
+    pub fn lookup_in(&self, record: usize, c: IVec3) -> Lookup {
         let l = local_index(c & IVec3::splat((1 << MACRO_SHIFT) - 1));
-        let bits = record.bits[l >> 6];
+        let bits = self.records[record].bits[l >> 6];
         let bit = 1u64 << (l & 63);
         if bits & bit == 0 {
             return Lookup::EmptyCell {
-                gap: self.gaps[word as usize].get(l),
+                gap: self.gaps[record].get(l),
             };
         }
-        let k = (self.ranks[word as usize][l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
+        let k = (self.ranks[record][l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
         Lookup::Blocks(self.offsets[k] as usize..self.offsets[k + 1] as usize)
     }
 
@@ -312,7 +326,7 @@ impl CellIndex {
         let occupied = |c: IVec3| {
             !matches!(
                 self.lookup(c),
-                Lookup::EmptyMacrocell { .. } | Lookup::EmptyCell { .. }
+                Lookup::EmptyMacrocell | Lookup::EmptyCell { .. }
             )
         };
         let mut sums = vec![0u32; sx * sy * (r.z as usize + 1)];

@@ -286,33 +286,47 @@ impl OccupiedCells<'_> {
         let walk = self.walk.as_mut()?;
         loop {
             stats.visit_cell();
-            let range = match grid.cells.lookup(walk.cell) {
-                Lookup::EmptyMacrocell { distance } => {
+            let record = match grid.cells.macrocell_of(walk.cell) {
+                Ok(record) => record,
+                Err(distance) => {
                     if !grid.skip_empty_macrocells(walk, self.ray, distance) {
                         self.walk = None;
                         return None;
                     }
                     continue;
                 }
-                // A cell next to an occupied one (gap 1) is left by an ordinary step: cheaper
-                // than leaving a cube of one cell.
-                Lookup::EmptyCell { gap } if gap >= 2 => {
-                    if !grid.skip_empty_cells(walk, self.ray, gap) {
-                        self.walk = None;
-                        return None;
-                    }
-                    continue;
-                }
-                Lookup::EmptyCell { .. } => None,
-                Lookup::Blocks(range) => Some(range),
             };
-            let (limit, more) = walk.advance();
-            if !more {
-                self.walk = None;
-                return range.map(|r| (r, limit));
-            }
-            if let Some(range) = range {
-                return Some((range, limit));
+            // Within one occupied macrocell, its record serves every step until the walk
+            // leaves it: no macrocell lookup per cell.
+            let macrocell = walk.cell >> MACRO_SHIFT;
+            loop {
+                match grid.cells.lookup_in(record, walk.cell) {
+                    // A cell next to an occupied one (gap 1) is left by an ordinary step:
+                    // cheaper than leaving a cube of one cell.
+                    Lookup::EmptyCell { gap } if gap >= 2 => {
+                        if !grid.skip_empty_cells(walk, self.ray, gap) {
+                            self.walk = None;
+                            return None;
+                        }
+                    }
+                    Lookup::Blocks(range) => {
+                        let (limit, more) = walk.advance();
+                        if !more {
+                            self.walk = None;
+                        }
+                        return Some((range, limit));
+                    }
+                    _ => {
+                        if !walk.advance().1 {
+                            self.walk = None;
+                            return None;
+                        }
+                    }
+                }
+                if walk.cell >> MACRO_SHIFT != macrocell {
+                    break;
+                }
+                stats.visit_cell();
             }
         }
     }
