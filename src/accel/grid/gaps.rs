@@ -124,6 +124,8 @@ impl Default for Scratch {
 /// rows `d..WINDOW − d` (in y and z) are brought up to date: the central macrocell's
 /// distances up to `MAX_RADIUS` depend on no others in the dilations still to come, and
 /// those rows' neighbours were up to date after the previous one.
+// Rows are read beside the one written (y ± 1, z ± 1): index loops say that most plainly.
+#[allow(clippy::needless_range_loop)]
 fn dilate(rows: &mut [[u32; WINDOW]; WINDOW], d: usize, scratch: &mut Scratch) {
     let mask = (1u32 << WINDOW) - 1;
     let (lo, hi) = (d, WINDOW - d);
