@@ -6,8 +6,8 @@
 //! found through a two-level index of macrocell records ([`cells`]), and each cell's
 //! triangles copied in blocks of eight, vertex and edges lane by lane, cell after cell, so
 //! a cell's triangles are one contiguous read and are tested eight at a time ([`block`]).
-//! Empty macrocells know their distance to the nearest occupied one, so the walk leaps over
-//! empty space. Traversal is the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if
+//! Empty macrocells know their distance to the nearest occupied one, and so do the empty
+//! cells of occupied macrocells ([`gaps`]), so the walk leaps over empty space. Traversal is the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if
 //! it lies within the current cell.
 
 mod block;

@@ -1,8 +1,9 @@
 //! Ray traversal: the 3D-DDA of Amanatides & Woo (1987), "A fast voxel traversal algorithm
 //! for ray tracing", over the two-level cell index ([`super::cells`]): an empty macrocell
-//! sends the walk past the whole empty cube around it in one step, an empty cell costs a
-//! bit test, and an occupied cell's blocks are tested eight triangles at a time. A grid of
-//! one cell is not walked: its blocks are tested at once.
+//! sends the walk past the whole empty cube around it in one step, so does an empty cell
+//! two or more cells from any occupied one ([`super::gaps`]), any other empty cell costs a
+//! bit test and a step, and an occupied cell's blocks are tested eight triangles at a time.
+//! A grid of one cell is not walked: its blocks are tested at once.
 
 use glam::{IVec3, UVec3};
 
@@ -316,7 +317,8 @@ impl OccupiedCells<'_> {
                         }
                         return Some((range, limit));
                     }
-                    _ => {
+                    // (`lookup_in` never answers `EmptyMacrocell`.)
+                    Lookup::EmptyCell { .. } | Lookup::EmptyMacrocell => {
                         if !walk.advance().1 {
                             self.walk = None;
                             return None;
