@@ -124,15 +124,10 @@ impl CellIndex {
         let m = self.macro_resolution.as_ivec3();
         let mut queue: VecDeque<IVec3> = VecDeque::new();
         let mut distance = vec![u32::MAX; self.macro_cells.len()];
-        for z in 0..m.z {
-            for y in 0..m.y {
-                for x in 0..m.x {
-                    let c = IVec3::new(x, y, z);
-                    if self.macro_cells[self.macro_index(c)] & EMPTY == 0 {
-                        distance[self.macro_index(c)] = 0;
-                        queue.push_back(c);
-                    }
-                }
+        for (c, word) in self.macrocells() {
+            if word & EMPTY == 0 {
+                distance[self.macro_index(c)] = 0;
+                queue.push_back(c);
             }
         }
         while let Some(c) = queue.pop_front() {
@@ -163,19 +158,26 @@ impl CellIndex {
         }
     }
 
+    /// Every macrocell's coordinates and word, x fastest.
+    fn macrocells(&self) -> impl Iterator<Item = (IVec3, u32)> + '_ {
+        let m = self.macro_resolution.as_ivec3();
+        (0..m.z).flat_map(move |z| {
+            (0..m.y).flat_map(move |y| {
+                (0..m.x).map(move |x| {
+                    let c = IVec3::new(x, y, z);
+                    (c, self.macro_cells[self.macro_index(c)])
+                })
+            })
+        })
+    }
+
     /// Each record's cell gaps ([`Gaps`]), in parallel over records.
     fn fill_gaps(&mut self) {
         let m = self.macro_resolution.as_ivec3();
         let mut at = vec![IVec3::ZERO; self.records.len()];
-        for z in 0..m.z {
-            for y in 0..m.y {
-                for x in 0..m.x {
-                    let c = IVec3::new(x, y, z);
-                    let word = self.macro_cells[self.macro_index(c)];
-                    if word & EMPTY == 0 {
-                        at[word as usize] = c;
-                    }
-                }
+        for (c, word) in self.macrocells() {
+            if word & EMPTY == 0 {
+                at[word as usize] = c;
             }
         }
         let index = &*self;
@@ -275,34 +277,28 @@ impl CellIndex {
             return Err("records and offsets disagree".into());
         }
         let m = self.macro_resolution.as_ivec3();
-        for z in 0..m.z {
-            for y in 0..m.y {
-                for x in 0..m.x {
-                    let c = IVec3::new(x, y, z);
-                    let word = self.macro_cells[self.macro_index(c)];
-                    if word & EMPTY == 0 {
-                        if self.records[word as usize].bits.iter().all(|&b| b == 0) {
-                            return Err(format!("macrocell {c} has a record but no cell"));
-                        }
-                        continue;
-                    }
-                    let d = (word & !EMPTY) as i32;
-                    if d < 1 {
-                        return Err(format!("empty macrocell {c} has distance {d}"));
-                    }
-                    let lo = (c - (d - 1)).max(IVec3::ZERO);
-                    let hi = (c + (d - 1)).min(m - 1);
-                    for nz in lo.z..=hi.z {
-                        for ny in lo.y..=hi.y {
-                            for nx in lo.x..=hi.x {
-                                let n = IVec3::new(nx, ny, nz);
-                                if self.macro_cells[self.macro_index(n)] & EMPTY == 0 {
-                                    return Err(format!(
-                                        "macrocell {n} is occupied, within {} of {c}",
-                                        d - 1
-                                    ));
-                                }
-                            }
+        for (c, word) in self.macrocells() {
+            if word & EMPTY == 0 {
+                if self.records[word as usize].bits.iter().all(|&b| b == 0) {
+                    return Err(format!("macrocell {c} has a record but no cell"));
+                }
+                continue;
+            }
+            let d = (word & !EMPTY) as i32;
+            if d < 1 {
+                return Err(format!("empty macrocell {c} has distance {d}"));
+            }
+            let lo = (c - (d - 1)).max(IVec3::ZERO);
+            let hi = (c + (d - 1)).min(m - 1);
+            for nz in lo.z..=hi.z {
+                for ny in lo.y..=hi.y {
+                    for nx in lo.x..=hi.x {
+                        let n = IVec3::new(nx, ny, nz);
+                        if self.macro_cells[self.macro_index(n)] & EMPTY == 0 {
+                            return Err(format!(
+                                "macrocell {n} is occupied, within {} of {c}",
+                                d - 1
+                            ));
                         }
                     }
                 }
