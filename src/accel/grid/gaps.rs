@@ -155,23 +155,13 @@ mod tests {
     /// Gaps found by brute force over the window: the distance to the nearest occupied cell.
     #[test]
     fn gaps_are_the_distance_to_the_nearest_occupied_cell() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rng = crate::render::sampling::Rng::new(5, 5);
+        let mut coordinate = || (rng.next_u32() % WINDOW as u32) as i32 - SIDE as i32;
         for round in 0..40 {
             // A few occupied cells scattered over the window, some neighbours empty.
             let mut occupied = std::collections::HashSet::new();
             for _ in 0..(1 + round % 6) {
-                let r = next();
-                let c = [
-                    (r % 24) as i32 - 8,
-                    ((r >> 8) % 24) as i32 - 8,
-                    ((r >> 16) % 24) as i32 - 8,
-                ];
+                let c = [coordinate(), coordinate(), coordinate()];
                 occupied.insert(c);
             }
             let words = |dx: i32, dy: i32, dz: i32| {
