@@ -4,7 +4,7 @@ use glam::{UVec3, Vec3};
 use rayon::prelude::*;
 
 use super::block::{Block, LANES};
-use super::cells::{CellIndex, MACRO_CELLS};
+use super::cells::{CellIndex, MACRO_CELLS, MACRO_SHIFT};
 use super::overlap::{Polygon, TriangleBoxTest};
 use super::{DEFAULT_DENSITY, Grid};
 use crate::accel::Triangle;
@@ -91,8 +91,10 @@ impl Grid {
                 within_reference_budget(wanted, bounds, &live_triangles),
             )
         };
+        let frame = GridFrame::new(bounds, resolution);
         let mut grid = Grid {
-            frame: GridFrame::new(bounds, resolution),
+            frame,
+            macro_frame: frame.coarsened(MACRO_SHIFT as u32),
             cells: CellIndex::default(),
             blocks: Vec::new(),
             references: 0,
@@ -106,6 +108,7 @@ impl Grid {
                 grid.frame.bounds,
                 (grid.frame.resolution / 2).max(UVec3::ONE),
             );
+            grid.macro_frame = grid.frame.coarsened(MACRO_SHIFT as u32);
         }
         grid
     }
