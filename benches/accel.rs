@@ -21,7 +21,6 @@ mod oracles;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use gridtrace::accel::grid::USE_SEGMENT_MASK;
 use gridtrace::accel::{Grid, Ray, TraversalCounts};
 use gridtrace::load::ply;
 use gridtrace::scene::Aabb;
@@ -29,7 +28,6 @@ use oracles::embree::Embree;
 use oracles::rays::{bounce_rays, outside_rays, segments};
 use oracles::{Mesh, Obvhs, dragon_path};
 use rayon::prelude::*;
-use std::sync::atomic::Ordering::Relaxed;
 
 const CHUNK: usize = 10_000;
 const REPEATS: usize = 7;
@@ -167,29 +165,15 @@ fn main() {
         for (name, rays, occlusion) in &sets {
             let queries: Vec<Query> = if *occlusion {
                 vec![
-                    Box::new(|r: &Ray| {
-                        USE_SEGMENT_MASK.store(true, Relaxed);
-                        grid.occluded(r)
-                    }),
+                    Box::new(|r: &Ray| grid.occluded(r)),
                     Box::new(|r: &Ray| embree.occluded(r)),
                     Box::new(|r: &Ray| bvh.occluded(r)),
-                    Box::new(|r: &Ray| {
-                        USE_SEGMENT_MASK.store(false, Relaxed);
-                        grid.occluded(r)
-                    }),
                 ]
             } else {
                 vec![
-                    Box::new(|r: &Ray| {
-                        USE_SEGMENT_MASK.store(true, Relaxed);
-                        grid.intersect(r).is_some()
-                    }),
+                    Box::new(|r: &Ray| grid.intersect(r).is_some()),
                     Box::new(|r: &Ray| embree.intersect(r).is_some()),
                     Box::new(|r: &Ray| bvh.intersect(r).is_some()),
-                    Box::new(|r: &Ray| {
-                        USE_SEGMENT_MASK.store(false, Relaxed);
-                        grid.intersect(r).is_some()
-                    }),
                 ]
             };
             // Queries run on this thread alone: single-thread figures.
@@ -199,13 +183,10 @@ fn main() {
             let (b, _, _) = summary(rates.iter().map(|r| r[2]).collect());
             let (ge, ge_lo, ge_hi) = summary(rates.iter().map(|r| r[0] / r[1]).collect());
             let (gb, gb_lo, gb_hi) = summary(rates.iter().map(|r| r[0] / r[2]).collect());
-            let (ab, ab_lo, ab_hi) = summary(rates.iter().map(|r| r[0] / r[3]).collect());
-            println!("A/B {model} {name}: with/without {ab:.3} ({ab_lo:.3}–{ab_hi:.3})");
             println!(
                 "| {model} | {n} | {name} | {g:.3} | {e:.3} | {b:.3} | {ge:.2} ({ge_lo:.2}–{ge_hi:.2}) | {gb:.2} ({gb_lo:.2}–{gb_hi:.2}) |"
             );
             if !*occlusion {
-                USE_SEGMENT_MASK.store(true, Relaxed);
                 let mut counts = TraversalCounts::default();
                 let mut hits = 0usize;
                 for r in rays {
@@ -213,8 +194,7 @@ fn main() {
                 }
                 let per_ray = |x: u64| x as f64 / rays.len() as f64;
                 notes.push(format!(
-                    "{model}, {name} rays: {:.2} macrocells skipped, {:.1} cells stepped, {:.1} occupied cells visited, {:.1} triangle tests, {:.2} hits per ray",
-                    per_ray(counts.skipped_macrocells),
+                    "{model}, {name} rays: {:.1} cells stepped, {:.1} occupied cells visited, {:.1} triangle tests, {:.2} hits per ray",
                     per_ray(counts.cells),
                     per_ray(counts.occupied),
                     per_ray(counts.tests),

@@ -73,22 +73,6 @@ impl GridFrame {
         (self.cell_of(b.min - pad), self.cell_of(b.max + pad))
     }
 
-    /// The frame of the grid's macrocells (blocks of 2^`shift` cells per axis), from the
-    /// same corner; the last ones may reach past the grid.
-    pub fn coarsened(&self, shift: u32) -> GridFrame {
-        let resolution = (self.resolution + UVec3::splat((1 << shift) - 1)) >> shift;
-        let cell_size = self.cell_size * (1 << shift) as f32;
-        GridFrame {
-            bounds: Aabb {
-                min: self.bounds.min,
-                max: self.bounds.min + resolution.as_vec3() * cell_size,
-            },
-            resolution,
-            cell_size,
-            inv_cell_size: cell_size.recip(),
-        }
-    }
-
     /// Clips the ray to the box and finds the first cell; `None` when it misses the box.
     /// Inlined, so that it is compiled with the caller's instruction set (otherwise
     /// `floor` is a call into libm).
@@ -135,53 +119,6 @@ impl GridFrame {
         };
         walk.refresh();
         Some(walk)
-    }
-
-    /// Moves the walk out of the box of cells `lo..=hi` (which holds the current
-    /// cell) to the first cell beyond it along the ray. False when the ray leaves the grid
-    /// first. Inlined into the walk, so that it is compiled with the walk's instruction set
-    /// (otherwise `floor` is a call into libm).
-    #[inline(always)]
-    pub fn leave_box(&self, walk: &mut CellWalk, ray: &Ray, lo: IVec3, hi: IVec3) -> bool {
-        let res = self.resolution.as_ivec3();
-        let mut axis = 0;
-        let mut t_exit = f32::INFINITY;
-        for a in 0..3 {
-            let face = if walk.step[a] > 0 { hi[a] + 1 } else { lo[a] };
-            let t = walk.face_t(a, face);
-            if t < t_exit {
-                t_exit = t;
-                axis = a;
-            }
-        }
-        if t_exit >= walk.t_end {
-            return false;
-        }
-        let next = if walk.step[axis] > 0 {
-            hi[axis] + 1
-        } else {
-            lo[axis] - 1
-        };
-        if next < 0 || next >= res[axis] {
-            return false;
-        }
-        // The other axes: the cell under the exit point, kept within the empty box and never
-        // behind the current cell, so rounding cannot move the walk backwards or sideways.
-        let p = ray.at(t_exit);
-        for a in 0..3 {
-            if a == axis {
-                walk.cell[a] = next;
-            } else if walk.step[a] != 0 {
-                let c = ((p[a] - self.bounds.min[a]) * self.inv_cell_size[a]).floor() as i32;
-                walk.cell[a] = if walk.step[a] > 0 {
-                    c.clamp(walk.cell[a], hi[a])
-                } else {
-                    c.clamp(lo[a], walk.cell[a])
-                };
-            }
-        }
-        walk.refresh();
-        true
     }
 }
 

@@ -4,7 +4,7 @@ use glam::{UVec3, Vec3};
 use rayon::prelude::*;
 
 use super::block::{Block, LANES};
-use super::cells::{CellIndex, MACRO_CELLS, MACRO_SHIFT};
+use super::cells::{CellIndex, MACRO_CELLS};
 use super::overlap::{Polygon, TriangleBoxTest};
 use super::{DEFAULT_DENSITY, Grid};
 use crate::accel::Triangle;
@@ -91,10 +91,8 @@ impl Grid {
                 within_reference_budget(wanted, bounds, &live_triangles),
             )
         };
-        let frame = GridFrame::new(bounds, resolution);
         let mut grid = Grid {
-            frame,
-            macro_frame: frame.coarsened(MACRO_SHIFT as u32),
+            frame: GridFrame::new(bounds, resolution),
             cells: CellIndex::default(),
             blocks: Vec::new(),
             references: 0,
@@ -108,7 +106,6 @@ impl Grid {
                 grid.frame.bounds,
                 (grid.frame.resolution / 2).max(UVec3::ONE),
             );
-            grid.macro_frame = grid.frame.coarsened(MACRO_SHIFT as u32);
         }
         grid
     }

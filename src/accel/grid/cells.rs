@@ -224,34 +224,6 @@ impl CellIndex {
         }
     }
 
-    /// The record of macrocell `m`, or (`Err`) its distance to the nearest occupied one
-    /// when it is empty.
-    #[inline(always)]
-    pub fn record_at(&self, m: IVec3) -> Result<usize, u32> {
-        let word = self.macro_cells[self.macro_index(m)];
-        if word & EMPTY != 0 {
-            Err(word & !EMPTY)
-        } else {
-            Ok(word as usize)
-        }
-    }
-
-    /// The occupancy words of record `record` (bit `x + 8y` of word `z`).
-    #[inline(always)]
-    pub fn bits(&self, record: usize) -> &[u64; MACRO_CELLS / 64] {
-        &self.records[record].bits
-    }
-
-    /// The blocks of the occupied cell `l` (its index within the macrocell) of record
-    /// `record`.
-    #[inline(always)]
-    pub fn blocks_at(&self, record: usize, l: usize) -> Range<usize> {
-        let bits = self.records[record].bits[l >> 6];
-        let below = bits & ((1u64 << (l & 63)) - 1);
-        let k = (self.ranks[record][l >> 6] + below.count_ones()) as usize;
-        self.offsets[k] as usize..self.offsets[k + 1] as usize
-    }
-
     /// What record `record` says about its cell `c`: `EmptyCell` or `Blocks`.
     #[inline(always)]
     pub fn lookup_in(&self, record: usize, c: IVec3) -> Lookup {

@@ -15,11 +15,9 @@ mod build;
 mod cells;
 mod gaps;
 mod overlap;
-mod segment_mask;
 mod traverse;
-mod walk;
 
-pub use traverse::{TraversalCounts, TraversalStats, USE_SEGMENT_MASK};
+pub use traverse::{TraversalCounts, TraversalStats};
 
 use glam::{UVec3, Vec3};
 
@@ -37,8 +35,6 @@ pub const DEFAULT_DENSITY: f32 = 5.0;
 pub struct Grid {
     /// The box the cells tile (the triangles' bounds, slightly padded) and its cells.
     frame: GridFrame,
-    /// The same box cut into macrocells, which the walk steps through.
-    macro_frame: GridFrame,
     /// Which cells hold triangles, and where their blocks lie.
     cells: CellIndex,
     /// The triangles of every occupied cell, eight to a block, cell after cell.

@@ -19,8 +19,6 @@ pub trait TraversalStats {
     fn visit_cell(&mut self) {}
     /// One occupied cell reached (its triangles are then tested).
     fn visit_occupied(&mut self) {}
-    /// One occupied macrocell left in one step, the ray meeting none of its cells.
-    fn skip_macrocell(&mut self) {}
     /// Ray–triangle tests (the triangles of one block, tested together).
     fn test_triangles(&mut self, _count: usize) {}
     /// One instance considered by the top level (its bounding box tested, and its grid
@@ -37,8 +35,6 @@ pub struct TraversalCounts {
     pub cells: u64,
     /// Occupied cells reached.
     pub occupied: u64,
-    /// Occupied macrocells passed in one step.
-    pub skipped_macrocells: u64,
     /// Ray–triangle tests.
     pub tests: u64,
     /// Instances considered by the top level.
@@ -52,9 +48,6 @@ impl TraversalStats for TraversalCounts {
     fn visit_occupied(&mut self) {
         self.occupied += 1;
     }
-    fn skip_macrocell(&mut self) {
-        self.skipped_macrocells += 1;
-    }
     fn test_triangles(&mut self, count: usize) {
         self.tests += count as u64;
     }
@@ -62,10 +55,6 @@ impl TraversalStats for TraversalCounts {
         self.instances += 1;
     }
 }
-
-/// Temporary A/B switch for the benchmark.
-pub static USE_SEGMENT_MASK: std::sync::atomic::AtomicBool =
-    std::sync::atomic::AtomicBool::new(true);
 
 impl Grid {
     /// The closest hit along `ray`, if any.
@@ -97,9 +86,6 @@ impl Grid {
 
     #[inline(always)]
     fn intersect_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
-        if USE_SEGMENT_MASK.load(std::sync::atomic::Ordering::Relaxed) {
-            return self.nearest_by_macrocells(ray, stats);
-        }
         // The nearest hit found so far, wherever it lies; it is the answer once it lies
         // within the cell being visited, since every later cell lies beyond that cell.
         let mut nearest: Option<GridHit> = None;
@@ -144,9 +130,6 @@ impl Grid {
 
     #[inline(always)]
     fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        if USE_SEGMENT_MASK.load(std::sync::atomic::Ordering::Relaxed) {
-            return self.any_by_macrocells(ray, stats);
-        }
         let mut cells = self.occupied_cells(ray);
         while let Some((range, _)) = cells.next(stats) {
             for block in &self.blocks[range] {
@@ -201,9 +184,52 @@ impl Grid {
         self.skip_cube(walk, ray, lo, hi)
     }
 
+    /// Moves the walk out of the empty box of cells `lo..=hi` (which holds the current
+    /// cell) to the first cell beyond it along the ray. False when the ray leaves the grid
+    /// first. Inlined into the walk, so that it is compiled with the walk's instruction set
+    /// (otherwise `floor` is a call into libm).
     #[inline(always)]
     fn skip_cube(&self, walk: &mut CellWalk, ray: &Ray, lo: IVec3, hi: IVec3) -> bool {
-        self.frame.leave_box(walk, ray, lo, hi)
+        let res = self.frame.resolution.as_ivec3();
+        let mut axis = 0;
+        let mut t_exit = f32::INFINITY;
+        for a in 0..3 {
+            let face = if walk.step[a] > 0 { hi[a] + 1 } else { lo[a] };
+            let t = walk.face_t(a, face);
+            if t < t_exit {
+                t_exit = t;
+                axis = a;
+            }
+        }
+        if t_exit >= walk.t_end {
+            return false;
+        }
+        let next = if walk.step[axis] > 0 {
+            hi[axis] + 1
+        } else {
+            lo[axis] - 1
+        };
+        if next < 0 || next >= res[axis] {
+            return false;
+        }
+        // The other axes: the cell under the exit point, kept within the empty box and never
+        // behind the current cell, so rounding cannot move the walk backwards or sideways.
+        let p = ray.at(t_exit);
+        for a in 0..3 {
+            if a == axis {
+                walk.cell[a] = next;
+            } else if walk.step[a] != 0 {
+                let c = ((p[a] - self.frame.bounds.min[a]) * self.frame.inv_cell_size[a]).floor()
+                    as i32;
+                walk.cell[a] = if walk.step[a] > 0 {
+                    c.clamp(walk.cell[a], hi[a])
+                } else {
+                    c.clamp(lo[a], walk.cell[a])
+                };
+            }
+        }
+        walk.refresh();
+        true
     }
 }
 
@@ -271,9 +297,9 @@ impl OccupiedCells<'_> {
                     continue;
                 }
             };
-            let macrocell = walk.cell >> MACRO_SHIFT;
             // Within one occupied macrocell, its record serves every step until the walk
             // leaves it: no macrocell lookup per cell.
+            let macrocell = walk.cell >> MACRO_SHIFT;
             loop {
                 match grid.cells.lookup_in(record, walk.cell) {
                     // A cell next to an occupied one (gap 1) is left by an ordinary step:
