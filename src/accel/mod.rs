@@ -4,6 +4,7 @@
 mod box_lanes;
 mod frame;
 pub mod grid;
+mod huge_pages;
 mod instances;
 mod ray;
 mod top_level;

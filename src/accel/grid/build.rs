@@ -7,8 +7,8 @@ use super::block::{Block, LANES};
 use super::cells::{CellIndex, MACRO_CELLS};
 use super::overlap::{Polygon, TriangleBoxTest};
 use super::{DEFAULT_DENSITY, Grid};
-use crate::accel::Triangle;
 use crate::accel::frame::{GridFrame, padded, resolution};
+use crate::accel::{Triangle, huge_pages};
 use crate::scene::Aabb;
 
 /// Meshes of at most this many triangles (two blocks) get a single cell: a wall, a box.
@@ -57,15 +57,30 @@ impl Grid {
         };
         // In parallel; the results are the same on any thread count (an ordered collect,
         // and bounds are exact minima and maxima).
-        let triangles: Vec<Option<Triangle>> = indices.par_iter().map(triangle).collect();
-        let live: Vec<u32> = (0..indices.len() as u32)
-            .into_par_iter()
-            .filter(|&i| triangles[i as usize].is_some())
-            .collect();
-        let tight = live
+        let mut triangles: Vec<Option<Triangle>> = huge_pages::vec_with_capacity(indices.len());
+        indices
             .par_iter()
-            .map(|&i| triangles[i as usize].unwrap().bounds())
-            .reduce(|| Aabb::EMPTY, Aabb::union);
+            .map(triangle)
+            .collect_into_vec(&mut triangles);
+        // The live triangles' numbers and bounds, chunk by chunk, joined in order.
+        const CHUNK: usize = 16384;
+        let parts: Vec<(Vec<u32>, Aabb)> = triangles
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(c, chunk)| {
+                let mut live = Vec::with_capacity(chunk.len());
+                let mut bounds = Aabb::EMPTY;
+                for (i, t) in chunk.iter().enumerate() {
+                    if let Some(t) = t {
+                        live.push((c * CHUNK + i) as u32);
+                        bounds = bounds.union(t.bounds());
+                    }
+                }
+                (live, bounds)
+            })
+            .collect();
+        let live: Vec<u32> = parts.iter().flat_map(|(l, _)| l.iter().copied()).collect();
+        let tight = parts.iter().fold(Aabb::EMPTY, |b, (_, p)| b.union(*p));
         let (bounds, resolution) = if tight.is_empty() {
             (
                 Aabb {
@@ -82,14 +97,7 @@ impl Grid {
             } else {
                 resolution(bounds.extent(), live.len(), density)
             };
-            let live_triangles: Vec<Triangle> = live
-                .par_iter()
-                .map(|&i| triangles[i as usize].unwrap())
-                .collect();
-            (
-                bounds,
-                within_reference_budget(wanted, bounds, &live_triangles),
-            )
+            (bounds, within_reference_budget(wanted, bounds, &triangles))
         };
         let mut grid = Grid {
             frame: GridFrame::new(bounds, resolution),
@@ -141,19 +149,25 @@ impl Grid {
         for &(key, _) in chunks.iter().flatten() {
             next[key as usize] += 1;
         }
-        let blocks_per_cell: Vec<u32> = next.iter().map(|n| n.div_ceil(LANES as u32)).collect();
+        let blocks_per_cell: Vec<u32> = next.par_iter().map(|n| n.div_ceil(LANES as u32)).collect();
         let cells = CellIndex::build(self.frame.resolution, &blocks_per_cell);
         // Each block's run of the sorted triangle numbers (start, length), in key order as
-        // the index numbers them; `next` becomes each cell's first place in the list.
+        // the index numbers them; `next` becomes each occupied cell's first place in the
+        // list (empty macrocells, most of the grid, are passed over whole).
         let mut runs: Vec<(u32, u32)> = Vec::with_capacity(cells.block_count());
         let mut start = 0u32;
-        for n in next.iter_mut() {
-            let count = *n;
-            for first in (0..count).step_by(LANES) {
-                runs.push((start + first, (count - first).min(LANES as u32)));
+        for macrocell in next.chunks_mut(MACRO_CELLS) {
+            if macrocell.iter().all(|&n| n == 0) {
+                continue;
             }
-            *n = start;
-            start += count;
+            for n in macrocell.iter_mut().filter(|n| **n != 0) {
+                let count = *n;
+                for first in (0..count).step_by(LANES) {
+                    runs.push((start + first, (count - first).min(LANES as u32)));
+                }
+                *n = start;
+                start += count;
+            }
         }
         debug_assert_eq!(runs.len(), cells.block_count());
         let mut sorted = vec![0u32; references];
@@ -162,8 +176,8 @@ impl Grid {
             next[key as usize] += 1;
         }
         drop(next);
-        let blocks: Vec<Block> = runs
-            .par_iter()
+        let mut blocks: Vec<Block> = huge_pages::vec_with_capacity(runs.len());
+        runs.par_iter()
             .map(|&(start, length)| {
                 let mut block = Block::EMPTY;
                 let run = &sorted[start as usize..(start + length) as usize];
@@ -172,7 +186,7 @@ impl Grid {
                 }
                 block
             })
-            .collect();
+            .collect_into_vec(&mut blocks);
         self.cells = cells;
         self.blocks = blocks;
         self.references = references;
@@ -263,8 +277,8 @@ const MAX_REFERENCES: f64 = (1u64 << 31) as f64;
 /// `wanted`, made coarser until the estimated references fit the budget. A triangle of
 /// area A and perimeter P overlaps about √3·A/s² + 2·P/s + 1 cells of side s (the cells its
 /// surface and its edges pass through), and never more than its bounding box holds.
-fn within_reference_budget(wanted: UVec3, bounds: Aabb, triangles: &[Triangle]) -> UVec3 {
-    let count = triangles.len() as f64;
+fn within_reference_budget(wanted: UVec3, bounds: Aabb, triangles: &[Option<Triangle>]) -> UVec3 {
+    let count = triangles.iter().flatten().count() as f64;
     let budget = (REFERENCES_PER_TRIANGLE * count + (1 << 20) as f64).min(MAX_REFERENCES);
     let mut r = wanted;
     for _ in 0..32 {
@@ -282,7 +296,7 @@ fn within_reference_budget(wanted: UVec3, bounds: Aabb, triangles: &[Triangle]) 
         // threads, so the same grid.
         let partial: Vec<f64> = triangles
             .par_chunks(4096)
-            .map(|chunk| chunk.iter().map(estimate_of).sum())
+            .map(|chunk| chunk.iter().flatten().map(estimate_of).sum())
             .collect();
         let estimate: f64 = partial.iter().sum();
         if estimate <= budget || r == UVec3::ONE {
