@@ -1,5 +1,6 @@
 //! The grid against Embree 4 (`rtcIntersect1`/`rtcOccluded1`) and the obvhs CWBVH on the
-//! Stanford dragon at several sizes: build time (median of 5), memory per triangle (each
+//! Stanford dragon at several sizes: build time (median of 5, the three built in turn),
+//! memory per triangle (each
 //! structure's own allocation: Embree's memory monitor, obvhs' node and index arrays, the
 //! grid's arrays), and single-thread throughput on four ray sets — rays from outside, a
 //! pinhole camera's rays, bounce rays from the surface, and shadow segments (`occluded`).
@@ -124,20 +125,26 @@ fn main() {
         let mesh = Mesh { positions, indices };
         let n = mesh.indices.len();
         let triangles = mesh.triangles();
-        // Builds, median of 5 (the builds use all threads, as the renderer's do).
-        let build = |f: &dyn Fn()| {
-            let times = (0..5).map(|_| timed(f).1.as_secs_f64()).collect();
-            summary(times).0
-        };
-        let grid_build = build(&|| {
-            drop(Grid::from_mesh_with_density(
-                mesh.positions.clone(),
-                &mesh.indices,
-                density,
-            ))
-        });
-        let embree_build = build(&|| drop(Embree::build(&mesh)));
-        let bvh_build = build(&|| drop(Obvhs::build(&mesh)));
+        // Builds, median of 5, the three structures in turn (the builds use all threads,
+        // as the renderer's do), so drifts of the machine's speed touch all three alike.
+        let mut build_times = [vec![], vec![], vec![]];
+        for _ in 0..5 {
+            let builds: [&dyn Fn(); 3] = [
+                &|| {
+                    drop(Grid::from_mesh_with_density(
+                        mesh.positions.clone(),
+                        &mesh.indices,
+                        density,
+                    ))
+                },
+                &|| drop(Embree::build(&mesh)),
+                &|| drop(Obvhs::build(&mesh)),
+            ];
+            for (times, build) in build_times.iter_mut().zip(builds) {
+                times.push(timed(build).1.as_secs_f64());
+            }
+        }
+        let [grid_build, embree_build, bvh_build] = build_times.map(|t| summary(t).0);
         let grid = Grid::from_mesh_with_density(mesh.positions.clone(), &mesh.indices, density);
         let embree = Embree::build(&mesh);
         let bvh = Obvhs::build(&mesh);
