@@ -1,9 +1,9 @@
 //! The grid against Embree 4 (`rtcIntersect1`/`rtcOccluded1`) and the obvhs CWBVH on the
 //! Stanford dragon at several sizes: build time (median of 5, the three built in turn),
-//! memory per triangle (each
-//! structure's own allocation: Embree's memory monitor, obvhs' node and index arrays, the
-//! grid's arrays), and single-thread throughput on four ray sets — rays from outside, a
-//! pinhole camera's rays, bounce rays from the surface, and shadow segments (`occluded`).
+//! memory per triangle (each structure's own allocation: Embree's memory monitor, obvhs'
+//! node and index arrays, the grid's arrays), and single-thread throughput on four ray
+//! sets — rays from outside, a pinhole camera's rays, bounce rays from the surface, and
+//! shadow segments (`occluded`).
 //!
 //! Timing: each set is cut into chunks of 10,000 rays; for every chunk the three structures
 //! take turns (in rotating order), each keeping the best of 7 repeats, so drifts of the
