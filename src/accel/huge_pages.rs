@@ -11,23 +11,28 @@ const WORTHWHILE: usize = 4 << 20;
 /// huge pages (a hint: where the system ignores it, nothing changes).
 pub(crate) fn vec_with_capacity<T>(capacity: usize) -> Vec<T> {
     let v: Vec<T> = Vec::with_capacity(capacity);
-    let bytes = v.capacity() * std::mem::size_of::<T>();
     #[cfg(target_os = "linux")]
-    if bytes >= WORTHWHILE {
-        const HUGE: usize = 2 << 20;
-        let start = v.as_ptr() as usize;
-        // The whole huge pages inside the allocation (madvise needs page-aligned ranges).
-        let first = start.next_multiple_of(HUGE);
-        let end = (start + bytes) / HUGE * HUGE;
-        if end > first {
-            // SAFETY: madvise only changes how the kernel backs these pages, which lie
-            // inside this vector's own allocation; it reads and writes no memory.
-            unsafe {
-                libc::madvise(first as *mut libc::c_void, end - first, libc::MADV_HUGEPAGE);
-            }
+    advise(v.as_ptr() as usize, v.capacity() * std::mem::size_of::<T>());
+    v
+}
+
+/// Advises the whole 2 MiB pages within `bytes` bytes from `start` (madvise needs
+/// page-aligned ranges) to be huge pages.
+#[cfg(target_os = "linux")]
+fn advise(start: usize, bytes: usize) {
+    const HUGE: usize = 2 << 20;
+    if bytes < WORTHWHILE {
+        return;
+    }
+    let first = start.next_multiple_of(HUGE);
+    let end = (start + bytes) / HUGE * HUGE;
+    if end > first {
+        // SAFETY: madvise only changes how the kernel backs these pages, which lie inside
+        // the caller's own allocation; it reads and writes no memory.
+        unsafe {
+            libc::madvise(first as *mut libc::c_void, end - first, libc::MADV_HUGEPAGE);
         }
     }
-    v
 }
 
 #[cfg(test)]

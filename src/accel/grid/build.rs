@@ -97,7 +97,10 @@ impl Grid {
             } else {
                 resolution(bounds.extent(), live.len(), density)
             };
-            (bounds, within_reference_budget(wanted, bounds, &triangles))
+            (
+                bounds,
+                within_reference_budget(wanted, bounds, &triangles, live.len()),
+            )
         };
         let mut grid = Grid {
             frame: GridFrame::new(bounds, resolution),
@@ -277,8 +280,14 @@ const MAX_REFERENCES: f64 = (1u64 << 31) as f64;
 /// `wanted`, made coarser until the estimated references fit the budget. A triangle of
 /// area A and perimeter P overlaps about √3·A/s² + 2·P/s + 1 cells of side s (the cells its
 /// surface and its edges pass through), and never more than its bounding box holds.
-fn within_reference_budget(wanted: UVec3, bounds: Aabb, triangles: &[Option<Triangle>]) -> UVec3 {
-    let count = triangles.iter().flatten().count() as f64;
+/// `triangles` holds `live` non-degenerate ones (the others, `None`, make no references).
+fn within_reference_budget(
+    wanted: UVec3,
+    bounds: Aabb,
+    triangles: &[Option<Triangle>],
+    live: usize,
+) -> UVec3 {
+    let count = live as f64;
     let budget = (REFERENCES_PER_TRIANGLE * count + (1 << 20) as f64).min(MAX_REFERENCES);
     let mut r = wanted;
     for _ in 0..32 {
