@@ -62,25 +62,32 @@ impl Grid {
             .par_iter()
             .map(triangle)
             .collect_into_vec(&mut triangles);
-        // The live triangles' numbers and bounds, chunk by chunk, joined in order.
+        // The live triangles' numbers, bounds and summed sizes, chunk by chunk, joined in
+        // order (so the sums are the same on any thread count).
         const CHUNK: usize = 16384;
-        let parts: Vec<(Vec<u32>, Aabb)> = triangles
+        let parts: Vec<(Vec<u32>, Aabb, Sizes)> = triangles
             .par_chunks(CHUNK)
             .enumerate()
             .map(|(c, chunk)| {
                 let mut live = Vec::with_capacity(chunk.len());
                 let mut bounds = Aabb::EMPTY;
+                let mut sizes = Sizes::default();
                 for (i, t) in chunk.iter().enumerate() {
                     if let Some(t) = t {
                         live.push((c * CHUNK + i) as u32);
                         bounds = bounds.union(t.bounds());
+                        sizes.add(&Sizes::of(t));
                     }
                 }
-                (live, bounds)
+                (live, bounds, sizes)
             })
             .collect();
-        let live: Vec<u32> = parts.iter().flat_map(|(l, _)| l.iter().copied()).collect();
-        let tight = parts.iter().fold(Aabb::EMPTY, |b, (_, p)| b.union(*p));
+        let live: Vec<u32> = parts.iter().flat_map(|(l, ..)| l.iter().copied()).collect();
+        let tight = parts.iter().fold(Aabb::EMPTY, |b, (_, p, _)| b.union(*p));
+        let mut sizes = Sizes::default();
+        for (.., part) in &parts {
+            sizes.add(part);
+        }
         let (bounds, resolution) = if tight.is_empty() {
             (
                 Aabb {
@@ -99,7 +106,7 @@ impl Grid {
             };
             (
                 bounds,
-                within_reference_budget(wanted, bounds, &triangles, live.len()),
+                within_reference_budget(wanted, bounds, &triangles, live.len(), &sizes),
             )
         };
         let mut grid = Grid {
@@ -280,26 +287,32 @@ const MAX_REFERENCES: f64 = (1u64 << 31) as f64;
 /// `wanted`, made coarser until the estimated references fit the budget. A triangle of
 /// area A and perimeter P overlaps about √3·A/s² + 2·P/s + 1 cells of side s (the cells its
 /// surface and its edges pass through), and never more than its bounding box holds.
-/// `triangles` holds `live` non-degenerate ones (the others, `None`, make no references).
+/// `triangles` holds `live` non-degenerate ones (the others, `None`, make no references),
+/// whose areas and perimeters add up to `sizes`: while the estimate without the bounding-box
+/// limit fits (the usual case), no pass over the triangles is needed.
 fn within_reference_budget(
     wanted: UVec3,
     bounds: Aabb,
     triangles: &[Option<Triangle>],
     live: usize,
+    sizes: &Sizes,
 ) -> UVec3 {
     let count = live as f64;
     let budget = (REFERENCES_PER_TRIANGLE * count + (1 << 20) as f64).min(MAX_REFERENCES);
+    let cells_met = |sizes: &Sizes, s: f64| {
+        3f64.sqrt() * sizes.area / (s * s) + 2.0 * sizes.perimeter / s + sizes.count
+    };
     let mut r = wanted;
     for _ in 0..32 {
         let cell = bounds.extent() / r.as_vec3();
         let s = cell.min_element().max(f32::MIN_POSITIVE) as f64;
+        if cells_met(sizes, s) <= budget {
+            break;
+        }
         let estimate_of = |t: &Triangle| {
-            let [a, b, c] = t.vertices();
-            let area = 0.5 * (b - a).cross(c - a).length() as f64;
-            let perimeter = ((b - a).length() + (c - b).length() + (a - c).length()) as f64;
             let reach = t.bounds().extent() / cell + 1.0;
             let boxed = reach.x as f64 * reach.y as f64 * reach.z as f64;
-            (3f64.sqrt() * area / (s * s) + 2.0 * perimeter / s + 1.0).min(boxed)
+            cells_met(&Sizes::of(t), s).min(boxed)
         };
         // Partial sums over fixed chunks, added in order: the same total on any number of
         // threads, so the same grid.
@@ -316,4 +329,88 @@ fn within_reference_budget(
         r = (r.as_vec3() * shrink).floor().max(Vec3::ONE).as_uvec3();
     }
     r
+}
+
+/// Areas, perimeters and number of triangles, summed: what the estimate of the cells they
+/// meet needs.
+#[derive(Clone, Copy, Debug, Default)]
+struct Sizes {
+    area: f64,
+    perimeter: f64,
+    count: f64,
+}
+
+impl Sizes {
+    fn of(t: &Triangle) -> Sizes {
+        let [a, b, c] = t.vertices();
+        Sizes {
+            area: 0.5 * (b - a).cross(c - a).length() as f64,
+            perimeter: ((b - a).length() + (c - b).length() + (a - c).length()) as f64,
+            count: 1.0,
+        }
+    }
+
+    fn add(&mut self, other: &Sizes) {
+        self.area += other.area;
+        self.perimeter += other.perimeter;
+        self.count += other.count;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sizes_of(triangles: &[Option<Triangle>]) -> Sizes {
+        let mut sizes = Sizes::default();
+        for t in triangles.iter().flatten() {
+            sizes.add(&Sizes::of(t));
+        }
+        sizes
+    }
+
+    /// Small triangles keep the resolution asked for (the summed estimate fits at once);
+    /// slivers across the whole box make it coarser until the clamped estimate fits.
+    #[test]
+    fn the_reference_budget_coarsens_only_grids_of_long_triangles() {
+        let bounds = Aabb {
+            min: Vec3::ZERO,
+            max: Vec3::splat(1.0),
+        };
+        let wanted = UVec3::splat(200);
+        let small: Vec<Option<Triangle>> = (0..2000)
+            .map(|i| {
+                let p = Vec3::new((i % 13) as f32, (i % 7) as f32, (i % 11) as f32) / 13.0;
+                Some(Triangle::new(p, p + Vec3::X * 0.01, p + Vec3::Y * 0.01))
+            })
+            .collect();
+        let r = within_reference_budget(wanted, bounds, &small, 2000, &sizes_of(&small));
+        assert_eq!(r, wanted);
+        let slivers: Vec<Option<Triangle>> = (0..2000)
+            .map(|i| {
+                let y = i as f32 / 2000.0;
+                Some(Triangle::new(
+                    Vec3::new(0.0, y, 0.0),
+                    Vec3::new(1.0, y, 1.0),
+                    Vec3::new(1.0, y + 1e-4, 1.0),
+                ))
+            })
+            .collect();
+        let r = within_reference_budget(wanted, bounds, &slivers, 2000, &sizes_of(&slivers));
+        assert!(r.x < wanted.x && r.x > 1, "{r}");
+        // What was chosen fits the budget by the clamped per-triangle estimate.
+        let cell = bounds.extent() / r.as_vec3();
+        let s = cell.min_element() as f64;
+        let estimate: f64 = slivers
+            .iter()
+            .flatten()
+            .map(|t| {
+                let reach = t.bounds().extent() / cell + 1.0;
+                let boxed = reach.x as f64 * reach.y as f64 * reach.z as f64;
+                let one = Sizes::of(t);
+                (3f64.sqrt() * one.area / (s * s) + 2.0 * one.perimeter / s + 1.0).min(boxed)
+            })
+            .sum();
+        assert!(estimate <= REFERENCES_PER_TRIANGLE * 2000.0 + (1 << 20) as f64);
+    }
 }
