@@ -106,7 +106,7 @@ impl Grid {
             };
             (
                 bounds,
-                within_reference_budget(wanted, bounds, &triangles, live.len(), &sizes),
+                within_reference_budget(wanted, bounds, &triangles, &sizes),
             )
         };
         let mut grid = Grid {
@@ -287,33 +287,24 @@ const MAX_REFERENCES: f64 = (1u64 << 31) as f64;
 /// `wanted`, made coarser until the estimated references fit the budget. A triangle of
 /// area A and perimeter P overlaps about √3·A/s² + 2·P/s + 1 cells of side s (the cells its
 /// surface and its edges pass through), and never more than its bounding box holds.
-/// `triangles` holds `live` non-degenerate ones (the others, `None`, make no references),
-/// whose areas and perimeters add up to `sizes`: while the estimate without the bounding-box
-/// limit fits (the usual case), no pass over the triangles is needed.
+/// The live ones of `triangles` (the others, `None`, make no references) add up to `sizes`:
+/// while the estimate without the bounding-box limit fits (the usual case), no pass over the
+/// triangles is needed.
 fn within_reference_budget(
     wanted: UVec3,
     bounds: Aabb,
     triangles: &[Option<Triangle>],
-    live: usize,
     sizes: &Sizes,
 ) -> UVec3 {
-    let count = live as f64;
-    let budget = (REFERENCES_PER_TRIANGLE * count + (1 << 20) as f64).min(MAX_REFERENCES);
-    let cells_met = |sizes: &Sizes, s: f64| {
-        3f64.sqrt() * sizes.area / (s * s) + 2.0 * sizes.perimeter / s + sizes.count
-    };
+    let budget = reference_budget(sizes.count);
     let mut r = wanted;
     for _ in 0..32 {
         let cell = bounds.extent() / r.as_vec3();
         let s = cell.min_element().max(f32::MIN_POSITIVE) as f64;
-        if cells_met(sizes, s) <= budget {
+        if sizes.cells_met(s) <= budget {
             break;
         }
-        let estimate_of = |t: &Triangle| {
-            let reach = t.bounds().extent() / cell + 1.0;
-            let boxed = reach.x as f64 * reach.y as f64 * reach.z as f64;
-            cells_met(&Sizes::of(t), s).min(boxed)
-        };
+        let estimate_of = |t: &Triangle| estimated_cells(t, cell);
         // Partial sums over fixed chunks, added in order: the same total on any number of
         // threads, so the same grid.
         let partial: Vec<f64> = triangles
@@ -340,7 +331,25 @@ struct Sizes {
     count: f64,
 }
 
+/// References (cell, triangle pairs) allowed for `count` triangles.
+fn reference_budget(count: f64) -> f64 {
+    (REFERENCES_PER_TRIANGLE * count + (1 << 20) as f64).min(MAX_REFERENCES)
+}
+
+/// Cells of size `cell` that triangle `t` meets, by the estimate above.
+fn estimated_cells(t: &Triangle, cell: Vec3) -> f64 {
+    let reach = t.bounds().extent() / cell + 1.0;
+    let boxed = reach.x as f64 * reach.y as f64 * reach.z as f64;
+    let s = cell.min_element().max(f32::MIN_POSITIVE) as f64;
+    Sizes::of(t).cells_met(s).min(boxed)
+}
+
 impl Sizes {
+    /// Cells of side `s` met by these triangles, without the bounding-box limit.
+    fn cells_met(&self, s: f64) -> f64 {
+        3f64.sqrt() * self.area / (s * s) + 2.0 * self.perimeter / s + self.count
+    }
+
     fn of(t: &Triangle) -> Sizes {
         let [a, b, c] = t.vertices();
         Sizes {
@@ -384,7 +393,7 @@ mod tests {
                 Some(Triangle::new(p, p + Vec3::X * 0.01, p + Vec3::Y * 0.01))
             })
             .collect();
-        let r = within_reference_budget(wanted, bounds, &small, 2000, &sizes_of(&small));
+        let r = within_reference_budget(wanted, bounds, &small, &sizes_of(&small));
         assert_eq!(r, wanted);
         let slivers: Vec<Option<Triangle>> = (0..2000)
             .map(|i| {
@@ -396,21 +405,15 @@ mod tests {
                 ))
             })
             .collect();
-        let r = within_reference_budget(wanted, bounds, &slivers, 2000, &sizes_of(&slivers));
+        let r = within_reference_budget(wanted, bounds, &slivers, &sizes_of(&slivers));
         assert!(r.x < wanted.x && r.x > 1, "{r}");
         // What was chosen fits the budget by the clamped per-triangle estimate.
         let cell = bounds.extent() / r.as_vec3();
-        let s = cell.min_element() as f64;
         let estimate: f64 = slivers
             .iter()
             .flatten()
-            .map(|t| {
-                let reach = t.bounds().extent() / cell + 1.0;
-                let boxed = reach.x as f64 * reach.y as f64 * reach.z as f64;
-                let one = Sizes::of(t);
-                (3f64.sqrt() * one.area / (s * s) + 2.0 * one.perimeter / s + 1.0).min(boxed)
-            })
+            .map(|t| estimated_cells(t, cell))
             .sum();
-        assert!(estimate <= REFERENCES_PER_TRIANGLE * 2000.0 + (1 << 20) as f64);
+        assert!(estimate <= reference_budget(2000.0));
     }
 }
