@@ -6,6 +6,7 @@ mod frame;
 pub mod grid;
 mod huge_pages;
 mod instances;
+mod prefetch;
 mod ray;
 mod top_level;
 mod triangle;

@@ -79,25 +79,6 @@ impl Block {
         })
     }
 
-    /// Asks the processor to start loading the block into its caches (a hint: it changes
-    /// no value and cannot fault).
-    #[inline(always)]
-    pub fn prefetch(&self) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            let base = (self as *const Block).cast::<i8>();
-            for line in (0..std::mem::size_of::<Block>()).step_by(64) {
-                // SAFETY: a prefetch only hints at an address (here inside the block) and
-                // never faults; SSE is part of every x86_64 processor.
-                unsafe {
-                    std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-                        base.wrapping_add(line),
-                    )
-                };
-            }
-        }
-    }
-
     /// Triangles in use.
     pub fn len(&self) -> usize {
         self.ids.iter().filter(|&&id| id != NO_TRIANGLE).count()

@@ -27,11 +27,17 @@ const EMPTY: u32 = 1 << 31;
 /// Distances are counted up to this (further is as good as this far).
 const MAX_DISTANCE: u32 = 255;
 
-/// Occupancy of the 512 cells of one macrocell (x fastest, then y, then z).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[repr(C, align(64))]
+/// What the walk needs to know about one occupied macrocell, in one place so that entering
+/// the macrocell can ask for all of it at once: the occupancy of its 512 cells (x fastest,
+/// then y, then z), per word of those bits the number of the word's first occupied cell (so
+/// an occupied cell's number is one popcount away, with no loop over words), and each
+/// cell's distance to the nearest occupied cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(128))]
 struct Record {
     bits: [u64; MACRO_CELLS / 64],
+    ranks: [u32; MACRO_CELLS / 64],
+    gaps: Gaps,
 }
 
 /// What the index says about one cell.
@@ -54,11 +60,6 @@ pub(super) struct CellIndex {
     /// Per macrocell: its record's index, or `EMPTY | distance`.
     macro_cells: Vec<u32>,
     records: Vec<Record>,
-    /// Per record, each cell's distance to the nearest occupied cell.
-    gaps: Vec<Gaps>,
-    /// Per record and per word of its bits, the number of the word's first occupied cell
-    /// (so an occupied cell's number is one popcount away, with no loop over words).
-    ranks: Vec<[u32; MACRO_CELLS / 64]>,
     /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes the blocks.
     offsets: Vec<u32>,
 }
@@ -92,29 +93,37 @@ impl CellIndex {
             ..CellIndex::default()
         };
         let mut total = 0u32;
+        let mut occupancy = Vec::new();
+        let mut ranks = Vec::new();
         for (mi, cells) in blocks.chunks(MACRO_CELLS).enumerate() {
             if cells.iter().all(|&n| n == 0) {
                 continue;
             }
-            let mut record = Record::default();
-            index.macro_cells[mi] = index.records.len() as u32;
-            let mut ranks = [0u32; MACRO_CELLS / 64];
+            index.macro_cells[mi] = occupancy.len() as u32;
+            let mut bits = [0u64; MACRO_CELLS / 64];
+            let mut first = [0u32; MACRO_CELLS / 64];
             for (l, &n) in cells.iter().enumerate() {
                 if l & 63 == 0 {
-                    ranks[l >> 6] = index.offsets.len() as u32;
+                    first[l >> 6] = index.offsets.len() as u32;
                 }
                 if n > 0 {
-                    record.bits[l >> 6] |= 1 << (l & 63);
+                    bits[l >> 6] |= 1 << (l & 63);
                     index.offsets.push(total);
                     total += n;
                 }
             }
-            index.records.push(record);
-            index.ranks.push(ranks);
+            occupancy.push(bits);
+            ranks.push(first);
         }
         index.offsets.push(total);
         index.fill_distances();
-        index.fill_gaps();
+        let gaps = index.gaps_of(&occupancy);
+        index.records = occupancy
+            .into_iter()
+            .zip(ranks)
+            .zip(gaps)
+            .map(|((bits, ranks), gaps)| Record { bits, ranks, gaps })
+            .collect();
         index
     }
 
@@ -171,18 +180,18 @@ impl CellIndex {
         })
     }
 
-    /// Each record's cell gaps ([`Gaps`]), in parallel over records.
-    fn fill_gaps(&mut self) {
+    /// The cell gaps ([`Gaps`]) of each occupied macrocell, given the occupancy bits of
+    /// each, in parallel over them.
+    fn gaps_of(&self, occupancy: &[[u64; MACRO_CELLS / 64]]) -> Vec<Gaps> {
         let m = self.macro_resolution.as_ivec3();
-        let mut at = vec![IVec3::ZERO; self.records.len()];
+        let mut at = vec![IVec3::ZERO; occupancy.len()];
         for (c, word) in self.macrocells() {
             if word & EMPTY == 0 {
                 at[word as usize] = c;
             }
         }
-        let index = &*self;
-        let gaps = at
-            .par_iter()
+        let index = self;
+        at.par_iter()
             .map(|&c| {
                 Gaps::of(|dx, dy, dz| {
                     let n = c + IVec3::new(dx, dy, dz);
@@ -190,11 +199,10 @@ impl CellIndex {
                         return None;
                     }
                     let word = index.macro_cells[index.macro_index(n)];
-                    (word & EMPTY == 0).then(|| index.records[word as usize].bits)
+                    (word & EMPTY == 0).then(|| occupancy[word as usize])
                 })
             })
-            .collect();
-        self.gaps = gaps;
+            .collect()
     }
 
     #[inline]
@@ -224,18 +232,26 @@ impl CellIndex {
         }
     }
 
+    /// Starts loading all of record `record` (its occupancy, ranks and gaps) at once: the
+    /// walk has just entered its macrocell and will read several parts of it.
+    #[inline(always)]
+    pub fn prefetch_record(&self, record: usize) {
+        crate::accel::prefetch::prefetch(&self.records[record]);
+    }
+
     /// What record `record` says about its cell `c`: `EmptyCell` or `Blocks`.
     #[inline(always)]
     pub fn lookup_in(&self, record: usize, c: IVec3) -> Lookup {
         let l = local_index(c & IVec3::splat((1 << MACRO_SHIFT) - 1));
-        let bits = self.records[record].bits[l >> 6];
+        let record = &self.records[record];
+        let bits = record.bits[l >> 6];
         let bit = 1u64 << (l & 63);
         if bits & bit == 0 {
             return Lookup::EmptyCell {
-                gap: self.gaps[record].get(l),
+                gap: record.gaps.get(l),
             };
         }
-        let k = (self.ranks[record][l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
+        let k = (record.ranks[l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
         Lookup::Blocks(self.offsets[k] as usize..self.offsets[k + 1] as usize)
     }
 
@@ -253,8 +269,6 @@ impl CellIndex {
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(self.macro_cells.as_slice())
             + std::mem::size_of_val(self.records.as_slice())
-            + std::mem::size_of_val(self.gaps.as_slice())
-            + std::mem::size_of_val(self.ranks.as_slice())
             + std::mem::size_of_val(self.offsets.as_slice())
     }
 
@@ -273,7 +287,7 @@ impl CellIndex {
             .flat_map(|r| r.bits)
             .map(u64::count_ones)
             .sum();
-        if counted as usize != self.occupied() || self.ranks.len() != self.records.len() {
+        if counted as usize != self.occupied() {
             return Err("records and offsets disagree".into());
         }
         let m = self.macro_resolution.as_ivec3();
@@ -313,9 +327,6 @@ impl CellIndex {
     /// sums over the whole grid (Crow 1984): the cube of cells within `gap − 1` holds
     /// none, and (below the cap) the cube within `gap` holds one.
     fn validate_gaps(&self, resolution: UVec3) -> Result<(), String> {
-        if self.gaps.len() != self.records.len() {
-            return Err("gaps and records disagree in length".into());
-        }
         let r = resolution.as_ivec3();
         let (sx, sy) = (r.x as usize + 1, r.y as usize + 1);
         let at = |x: i32, y: i32, z: i32| x as usize + sx * (y as usize + sy * z as usize);
