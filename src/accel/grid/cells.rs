@@ -60,6 +60,9 @@ pub(super) struct CellIndex {
     /// Per macrocell: its record's index, or `EMPTY | distance`.
     macro_cells: Vec<u32>,
     records: Vec<Record>,
+    /// Per record, the number of its first occupied cell (its first rank, kept apart so
+    /// that its offsets can be asked for together with the record, before it arrives).
+    first_cells: Vec<u32>,
     /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes the blocks.
     offsets: Vec<u32>,
 }
@@ -118,6 +121,7 @@ impl CellIndex {
         index.offsets.push(total);
         index.fill_distances();
         let gaps = index.gaps_of(&occupancy);
+        index.first_cells = ranks.iter().map(|r| r[0]).collect();
         index.records = occupancy
             .into_iter()
             .zip(ranks)
@@ -232,11 +236,16 @@ impl CellIndex {
         }
     }
 
-    /// Starts loading all of record `record` (its occupancy, ranks and gaps) at once: the
-    /// walk has just entered its macrocell and will read several parts of it.
+    /// Starts loading all of record `record` (its occupancy, ranks and gaps) and the first
+    /// two cache lines of its cells' offsets at once: the walk has just entered its
+    /// macrocell and will read several parts of them, one after another.
     #[inline(always)]
     pub fn prefetch_record(&self, record: usize) {
-        crate::accel::prefetch::prefetch(&self.records[record]);
+        use crate::accel::prefetch::prefetch;
+        prefetch(&self.records[record]);
+        let first = self.first_cells[record] as usize;
+        prefetch(&self.offsets[first]);
+        prefetch(&self.offsets[(first + 16).min(self.offsets.len() - 1)]);
     }
 
     /// What record `record` says about its cell `c`: `EmptyCell` or `Blocks`.
@@ -269,6 +278,7 @@ impl CellIndex {
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(self.macro_cells.as_slice())
             + std::mem::size_of_val(self.records.as_slice())
+            + std::mem::size_of_val(self.first_cells.as_slice())
             + std::mem::size_of_val(self.offsets.as_slice())
     }
 
@@ -289,6 +299,15 @@ impl CellIndex {
             .sum();
         if counted as usize != self.occupied() {
             return Err("records and offsets disagree".into());
+        }
+        if self.first_cells.len() != self.records.len()
+            || self
+                .first_cells
+                .iter()
+                .zip(&self.records)
+                .any(|(&f, r)| f != r.ranks[0])
+        {
+            return Err("a record's first cell is not its first rank".into());
         }
         let m = self.macro_resolution.as_ivec3();
         for (c, word) in self.macrocells() {
