@@ -1,31 +1,32 @@
 //! Which cells of a grid hold triangles, and where their blocks lie: a two-level index.
 //!
 //! The cells are grouped in macrocells of 8³. One word per macrocell says either where its
-//! record is, or — for an empty macrocell — how far the nearest occupied macrocell is
-//! (Chebyshev distance, so the walk can leap over a whole cube of empty space: proximity
-//! clouds, Cohen & Sheffer 1994). A record is one cache line: 512 occupancy bits, one per
-//! cell. Occupied cells are numbered macrocell by macrocell, so an occupied cell's number is
-//! its record's first number plus a popcount over that one cache line, and the offsets of
-//! the cells of one macrocell lie together. A ray stepping through a macrocell thus reads
-//! one record line instead of occupancy words scattered over whole rows of the grid.
+//! record is, or — for an empty macrocell — how far empty space reaches from it towards
+//! each octant of directions ([`super::reach`]), so the walk can leap over a whole box of
+//! empty macrocells. A record holds the 512 occupancy bits of its cells, the ranks and the
+//! cells' gaps ([`super::gaps`]), together so that entering the macrocell asks for all of
+//! them at once. Occupied cells are numbered macrocell by macrocell, so an occupied cell's
+//! number is its word's rank plus a popcount within one 64-bit word, and the offsets of the
+//! cells of one macrocell lie together. A ray stepping through a macrocell thus reads one
+//! record instead of occupancy words scattered over whole rows of the grid.
 
-use std::collections::VecDeque;
 use std::ops::Range;
 
 use glam::{IVec3, UVec3};
 use rayon::prelude::*;
 
+use super::box_counts::BoxCounts;
 use super::gaps::Gaps;
+use super::reach::{self, MAX_REACH};
 
 /// A macrocell is 2^MACRO_SHIFT cells along each axis.
 pub(super) const MACRO_SHIFT: i32 = 3;
 /// Cells per macrocell.
 pub(super) const MACRO_CELLS: usize = 1 << (3 * MACRO_SHIFT);
 
-/// Set in a macrocell's word when it is empty; the low bits are then its distance.
-const EMPTY: u32 = 1 << 31;
-/// Distances are counted up to this (further is as good as this far).
-const MAX_DISTANCE: u32 = 255;
+/// Set in a macrocell's word when it is empty; the low bits are then its reaches
+/// ([`reach`]).
+const EMPTY: u64 = 1 << 63;
 
 /// What the walk needs to know about one occupied macrocell, in one place so that entering
 /// the macrocell can ask for all of it at once: the occupancy of its 512 cells (x fastest,
@@ -42,7 +43,7 @@ struct Record {
 
 /// What the index says about one cell.
 pub(super) enum Lookup {
-    /// The cell's macrocell is empty (its distance to an occupied one is
+    /// The cell's macrocell is empty (how far empty space reaches from it is
     /// [`CellIndex::macrocell_of`]'s answer).
     EmptyMacrocell,
     /// The cell is empty (its macrocell is not), and so is every cell within Chebyshev
@@ -57,8 +58,8 @@ pub(super) enum Lookup {
 pub(super) struct CellIndex {
     /// Macrocells per axis.
     macro_resolution: UVec3,
-    /// Per macrocell: its record's index, or `EMPTY | distance`.
-    macro_cells: Vec<u32>,
+    /// Per macrocell: its record's index, or `EMPTY |` its reaches, packed.
+    macro_cells: Vec<u64>,
     records: Vec<Record>,
     /// Per record, the number of its first occupied cell (its first rank, kept apart so
     /// that its offsets can be asked for together with the record, before it arrives).
@@ -102,7 +103,7 @@ impl CellIndex {
             if cells.iter().all(|&n| n == 0) {
                 continue;
             }
-            index.macro_cells[mi] = occupancy.len() as u32;
+            index.macro_cells[mi] = occupancy.len() as u64;
             let mut bits = [0u64; MACRO_CELLS / 64];
             let mut first = [0u32; MACRO_CELLS / 64];
             for (l, &n) in cells.iter().enumerate() {
@@ -119,7 +120,7 @@ impl CellIndex {
             ranks.push(first);
         }
         index.offsets.push(total);
-        index.fill_distances();
+        index.fill_reaches();
         let gaps = index.gaps_of(&occupancy);
         index.first_cells = ranks.iter().map(|r| r[0]).collect();
         index.records = occupancy
@@ -131,48 +132,19 @@ impl CellIndex {
         index
     }
 
-    /// Chebyshev distances of the empty macrocells to the nearest occupied one: a
-    /// breadth-first search from the occupied macrocells over 26 neighbours.
-    fn fill_distances(&mut self) {
-        let m = self.macro_resolution.as_ivec3();
-        let mut queue: VecDeque<IVec3> = VecDeque::new();
-        let mut distance = vec![u32::MAX; self.macro_cells.len()];
-        for (c, word) in self.macrocells() {
-            if word & EMPTY == 0 {
-                distance[self.macro_index(c)] = 0;
-                queue.push_back(c);
-            }
-        }
-        while let Some(c) = queue.pop_front() {
-            let d = distance[self.macro_index(c)];
-            if d >= MAX_DISTANCE {
-                continue;
-            }
-            for dz in -1..=1 {
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        let n = c + IVec3::new(dx, dy, dz);
-                        if n.cmplt(IVec3::ZERO).any() || n.cmpge(m).any() {
-                            continue;
-                        }
-                        let i = self.macro_index(n);
-                        if distance[i] == u32::MAX {
-                            distance[i] = d + 1;
-                            queue.push_back(n);
-                        }
-                    }
-                }
-            }
-        }
-        for (word, d) in self.macro_cells.iter_mut().zip(distance) {
+    /// The reaches of the empty macrocells ([`reach`]).
+    fn fill_reaches(&mut self) {
+        let words = &self.macro_cells;
+        let packed = reach::reaches(self.macro_resolution.as_ivec3(), |i| words[i] & EMPTY == 0);
+        for (word, reaches) in self.macro_cells.iter_mut().zip(packed) {
             if *word & EMPTY != 0 {
-                *word = EMPTY | d.min(MAX_DISTANCE);
+                *word = EMPTY | reaches;
             }
         }
     }
 
     /// Every macrocell's coordinates and word, x fastest.
-    fn macrocells(&self) -> impl Iterator<Item = (IVec3, u32)> + '_ {
+    fn macrocells(&self) -> impl Iterator<Item = (IVec3, u64)> + '_ {
         let m = self.macro_resolution.as_ivec3();
         (0..m.z).flat_map(move |z| {
             (0..m.y).flat_map(move |y| {
@@ -218,19 +190,19 @@ impl CellIndex {
     /// What the index says about cell `c` (inside the grid).
     #[inline(always)]
     pub fn lookup(&self, c: IVec3) -> Lookup {
-        match self.macrocell_of(c) {
+        match self.macrocell_of(c, 0) {
             Err(_) => Lookup::EmptyMacrocell,
             Ok(record) => self.lookup_in(record, c),
         }
     }
 
-    /// The record of cell `c`'s macrocell, or (`Err`) the macrocell's distance to the
-    /// nearest occupied one when it is empty.
+    /// The record of cell `c`'s macrocell, or (`Err`) when it is empty its reach towards
+    /// `octant` ([`reach`]).
     #[inline(always)]
-    pub fn macrocell_of(&self, c: IVec3) -> Result<usize, u32> {
+    pub fn macrocell_of(&self, c: IVec3, octant: u32) -> Result<usize, u32> {
         let word = self.macro_cells[self.macro_index(c >> MACRO_SHIFT)];
         if word & EMPTY != 0 {
-            Err(word & !EMPTY)
+            Err(reach::unpack(word, octant))
         } else {
             Ok(word as usize)
         }
@@ -309,7 +281,9 @@ impl CellIndex {
         {
             return Err("a record's first cell is not its first rank".into());
         }
-        let m = self.macro_resolution.as_ivec3();
+        let macro_counts = BoxCounts::new(self.macro_resolution.as_ivec3(), |c| {
+            self.macro_cells[self.macro_index(c)] & EMPTY == 0
+        });
         for (c, word) in self.macrocells() {
             if word & EMPTY == 0 {
                 if self.records[word as usize].bits.iter().all(|&b| b == 0) {
@@ -317,23 +291,19 @@ impl CellIndex {
                 }
                 continue;
             }
-            let d = (word & !EMPTY) as i32;
-            if d < 1 {
-                return Err(format!("empty macrocell {c} has distance {d}"));
-            }
-            let lo = (c - (d - 1)).max(IVec3::ZERO);
-            let hi = (c + (d - 1)).min(m - 1);
-            for nz in lo.z..=hi.z {
-                for ny in lo.y..=hi.y {
-                    for nx in lo.x..=hi.x {
-                        let n = IVec3::new(nx, ny, nz);
-                        if self.macro_cells[self.macro_index(n)] & EMPTY == 0 {
-                            return Err(format!(
-                                "macrocell {n} is occupied, within {} of {c}",
-                                d - 1
-                            ));
-                        }
-                    }
+            for octant in 0..8 {
+                let k = reach::unpack(word, octant);
+                let (lo, hi) = reach::reach_box(c, octant, k);
+                if k < 1 || macro_counts.count(lo, hi) != 0 {
+                    return Err(format!(
+                        "empty macrocell {c} reaches {k} towards octant {octant}, past an occupied one"
+                    ));
+                }
+                let (lo, hi) = reach::reach_box(c, octant, k + 1);
+                if k < MAX_REACH && macro_counts.count(lo, hi) == 0 {
+                    return Err(format!(
+                        "empty macrocell {c} reaches only {k} towards octant {octant}"
+                    ));
                 }
             }
         }
@@ -342,48 +312,19 @@ impl CellIndex {
 }
 
 impl CellIndex {
-    /// Checks every stored gap against a count of occupied cells in boxes, from a table of
-    /// sums over the whole grid (Crow 1984): the cube of cells within `gap − 1` holds
-    /// none, and (below the cap) the cube within `gap` holds one.
+    /// Checks every stored gap against a count of occupied cells in boxes
+    /// ([`BoxCounts`]): the cube of cells within `gap − 1` holds none, and (below the cap)
+    /// the cube within `gap` holds one.
     fn validate_gaps(&self, resolution: UVec3) -> Result<(), String> {
         let r = resolution.as_ivec3();
-        let (sx, sy) = (r.x as usize + 1, r.y as usize + 1);
-        let at = |x: i32, y: i32, z: i32| x as usize + sx * (y as usize + sy * z as usize);
-        let occupied = |c: IVec3| {
+        let counts = BoxCounts::new(r, |c| {
             !matches!(
                 self.lookup(c),
                 Lookup::EmptyMacrocell | Lookup::EmptyCell { .. }
             )
-        };
-        let mut sums = vec![0u32; sx * sy * (r.z as usize + 1)];
-        for z in 0..r.z {
-            for y in 0..r.y {
-                for x in 0..r.x {
-                    let own = u32::from(occupied(IVec3::new(x, y, z)));
-                    sums[at(x + 1, y + 1, z + 1)] = own
-                        .wrapping_add(sums[at(x, y + 1, z + 1)])
-                        .wrapping_add(sums[at(x + 1, y, z + 1)])
-                        .wrapping_add(sums[at(x + 1, y + 1, z)])
-                        .wrapping_sub(sums[at(x, y, z + 1)])
-                        .wrapping_sub(sums[at(x, y + 1, z)])
-                        .wrapping_sub(sums[at(x + 1, y, z)])
-                        .wrapping_add(sums[at(x, y, z)]);
-                }
-            }
-        }
+        });
         // Occupied cells within Chebyshev distance `reach` of `c`.
-        let around = |c: IVec3, reach: i32| {
-            let lo = (c - reach).max(IVec3::ZERO);
-            let hi = (c + reach + 1).min(r);
-            sums[at(hi.x, hi.y, hi.z)]
-                .wrapping_sub(sums[at(lo.x, hi.y, hi.z)])
-                .wrapping_sub(sums[at(hi.x, lo.y, hi.z)])
-                .wrapping_sub(sums[at(hi.x, hi.y, lo.z)])
-                .wrapping_add(sums[at(lo.x, lo.y, hi.z)])
-                .wrapping_add(sums[at(lo.x, hi.y, lo.z)])
-                .wrapping_add(sums[at(hi.x, lo.y, lo.z)])
-                .wrapping_sub(sums[at(lo.x, lo.y, lo.z)])
-        };
+        let around = |c: IVec3, reach: i32| counts.count(c - reach, c + reach);
         for z in 0..r.z {
             for y in 0..r.y {
                 for x in 0..r.x {

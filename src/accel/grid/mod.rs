@@ -6,15 +6,19 @@
 //! found through a two-level index of macrocell records ([`cells`]), and each cell's
 //! triangles copied in blocks of eight, vertex and edges lane by lane, cell after cell, so
 //! a cell's triangles are one contiguous read and are tested eight at a time ([`block`]).
-//! Empty macrocells know their distance to the nearest occupied one, and so do the empty
-//! cells of occupied macrocells ([`gaps`]), so the walk leaps over empty space. Traversal is the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if
-//! it lies within the current cell.
+//! Empty macrocells know how far empty space reaches from them towards each octant of
+//! directions ([`reach`]), and empty cells of occupied macrocells their distance to the
+//! nearest occupied cell ([`gaps`]), so the walk leaps over empty space. Traversal is the
+//! 3D-DDA of Amanatides & Woo (1987), accepting a hit only if it lies within the current
+//! cell.
 
 mod block;
+mod box_counts;
 mod build;
 mod cells;
 mod gaps;
 mod overlap;
+mod reach;
 mod traverse;
 
 pub use traverse::{TraversalCounts, TraversalStats};

@@ -1,15 +1,17 @@
 //! Ray traversal: the 3D-DDA of Amanatides & Woo (1987), "A fast voxel traversal algorithm
 //! for ray tracing", over the two-level cell index ([`super::cells`]): an empty macrocell
-//! sends the walk past the whole empty cube around it in one step, so does an empty cell
-//! two or more cells from any occupied one ([`super::gaps`]), any other empty cell costs a
-//! bit test and a step, and an occupied cell's blocks are tested eight triangles at a time.
-//! A grid of one cell is not walked: its blocks are tested at once.
+//! sends the walk past the whole empty box ahead of it in one step ([`super::reach`]), an
+//! empty cell past the empty cube around it if it is two or more cells from any occupied
+//! one ([`super::gaps`]), any other empty cell costs a bit test and a step, and an occupied
+//! cell's blocks are tested eight triangles at a time. A grid of one cell is not walked:
+//! its blocks are tested at once.
 
 use std::ops::Range;
 
 use glam::{IVec3, UVec3};
 
 use super::cells::{Lookup, MACRO_SHIFT};
+use super::reach;
 use super::{Grid, GridHit};
 use crate::accel::Ray;
 use crate::accel::frame::CellWalk;
@@ -157,22 +159,28 @@ impl Grid {
         OccupiedCells {
             grid: self,
             ray,
+            octant: walk.map_or(0, |w| reach::octant(w.step)),
             walk,
             single_cell: single_cell && !self.blocks.is_empty(),
             ahead: None,
         }
     }
 
-    /// Moves the walk past the empty cube of macrocells around its current cell (of
-    /// Chebyshev radius `distance − 1`), to the first cell beyond it along the ray. False
-    /// when the ray leaves the grid first.
+    /// Moves the walk past the empty cube of macrocells that reaches `reach` macrocells
+    /// from its current one towards `octant` ([`reach`]), to the first cell beyond it along
+    /// the ray. False when the ray leaves the grid first.
     #[inline(always)]
-    fn skip_empty_macrocells(&self, walk: &mut CellWalk, ray: &Ray, distance: u32) -> bool {
+    fn skip_empty_macrocells(
+        &self,
+        walk: &mut CellWalk,
+        ray: &Ray,
+        octant: u32,
+        reach: u32,
+    ) -> bool {
         let res = self.frame.resolution.as_ivec3();
-        let reach = distance.max(1) as i32 - 1;
-        let macrocell = walk.cell >> MACRO_SHIFT;
-        let lo = ((macrocell - reach) << MACRO_SHIFT).max(IVec3::ZERO);
-        let hi = (((macrocell + reach + 1) << MACRO_SHIFT) - 1).min(res - 1);
+        let (lo, hi) = reach::reach_box(walk.cell >> MACRO_SHIFT, octant, reach.max(1));
+        let lo = (lo << MACRO_SHIFT).max(IVec3::ZERO);
+        let hi = (((hi + 1) << MACRO_SHIFT) - 1).min(res - 1);
         self.skip_cube(walk, ray, lo, hi)
     }
 
@@ -243,6 +251,8 @@ struct OccupiedCells<'a> {
     ray: &'a Ray,
     /// `None` once the ray has left the grid.
     walk: Option<CellWalk>,
+    /// The octant of the ray's direction ([`reach::octant`]).
+    octant: u32,
     /// True until the one cell of a single-cell grid has been given out: such a grid is not
     /// walked (a few triangles are tested faster all at once than found by a walk).
     single_cell: bool,
@@ -290,13 +300,13 @@ impl OccupiedCells<'_> {
         let walk = self.walk.as_mut()?;
         loop {
             stats.visit_cell();
-            let record = match grid.cells.macrocell_of(walk.cell) {
+            let record = match grid.cells.macrocell_of(walk.cell, self.octant) {
                 Ok(record) => {
                     grid.cells.prefetch_record(record);
                     record
                 }
-                Err(distance) => {
-                    if !grid.skip_empty_macrocells(walk, self.ray, distance) {
+                Err(reach) => {
+                    if !grid.skip_empty_macrocells(walk, self.ray, self.octant, reach) {
                         self.walk = None;
                         return None;
                     }
