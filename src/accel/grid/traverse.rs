@@ -272,8 +272,8 @@ impl OccupiedCells<'_> {
     /// blocks from memory (about 170 ns on a mesh the size of the full dragon) is the
     /// largest single cost of a query, and the walk asks for all of a cell's blocks as soon
     /// as it finds the cell ([`OccupiedCells::find_next`]), so those reads overlap the
-    /// tests of the cell before. Two cells ahead gained 1.03–1.06× on the full dragon's
-    /// bounce rays but lost 0.89–0.93× on its outside rays: cells found beyond the hit are
+    /// tests of the cell before. Two cells ahead gained 1.00–1.03× on the full dragon's
+    /// bounce rays but lost 0.89× on its outside rays: cells found beyond the hit are
     /// wasted work.
     #[inline(always)]
     fn next(&mut self, stats: &mut impl TraversalStats) -> Option<Found> {
