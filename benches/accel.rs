@@ -8,8 +8,9 @@
 //! Timing: each set is cut into chunks of 10,000 rays; for every chunk the three structures
 //! take turns (in rotating order), each keeping the best of 7 repeats, so drifts of the
 //! machine's speed touch all three alike. That is one run; the ratios are reported as the
-//! median and the range over 5 runs. Then the grid's own counters per ray, and its speed-up
-//! on all threads.
+//! median and the range over 5 runs. Then the grid's own counters per ray, each query's
+//! time per ray with caches cold and warm ([`cold_and_warm`]), and the grid's speed-up on
+//! all threads.
 //!
 //! Run with `cargo bench --bench accel` after `tools/setup-dev.sh`. Environment:
 //! `ACCEL_BENCH_MODELS` (comma-separated files of data/dragon, default the smallest, a
@@ -97,6 +98,46 @@ fn run_once(rays: &[Ray], queries: &[Query], run: usize) -> Vec<f64> {
     total
         .iter()
         .map(|t| rays.len() as f64 / t.as_secs_f64() / 1e6)
+        .collect()
+}
+
+/// How many times in a row each ray is traced for the warm figure.
+const WARM_REPEATS: usize = 8;
+
+/// Nanoseconds per ray of each query, cold and warm, for one run: every ray traced once
+/// (as a stream of unrelated rays leaves the caches), then every ray `WARM_REPEATS` times
+/// in a row (all but the first find what the ray needs in cache), chunk by chunk with the
+/// queries in rotating order. Warm is (R·T_R − T_1)/(R − 1); cold minus warm is the time
+/// a ray waits for memory.
+fn cold_and_warm(rays: &[Ray], queries: &[Query], run: usize) -> Vec<(f64, f64)> {
+    let mut once = vec![Duration::ZERO; queries.len()];
+    let mut repeated = vec![Duration::ZERO; queries.len()];
+    for (c, chunk) in rays.chunks(CHUNK).enumerate() {
+        for k in 0..queries.len() {
+            let q = (k + c + run) % queries.len();
+            let (hits, t) = timed(|| chunk.iter().filter(|r| queries[q](r)).count());
+            std::hint::black_box(hits);
+            once[q] += t;
+            let (hits, t) = timed(|| {
+                chunk
+                    .iter()
+                    .flat_map(|r| std::iter::repeat_n(r, WARM_REPEATS))
+                    .filter(|r| queries[q](r))
+                    .count()
+            });
+            std::hint::black_box(hits);
+            repeated[q] += t;
+        }
+    }
+    let n = rays.len() as f64;
+    let r = WARM_REPEATS as f64;
+    once.iter()
+        .zip(&repeated)
+        .map(|(t1, tr)| {
+            let cold = t1.as_secs_f64() * 1e9 / n;
+            let all = tr.as_secs_f64() * 1e9 / n;
+            (cold, (all - cold) / (r - 1.0))
+        })
         .collect()
 }
 
@@ -193,6 +234,25 @@ fn main() {
             println!(
                 "| {model} | {n} | {name} | {g:.3} | {e:.3} | {b:.3} | {ge:.2} ({ge_lo:.2}–{ge_hi:.2}) | {gb:.2} ({gb_lo:.2}–{gb_hi:.2}) |"
             );
+            let times: Vec<Vec<(f64, f64)>> = (0..runs)
+                .map(|run| cold_and_warm(rays, &queries, run))
+                .collect();
+            let [grid_t, embree_t, bvh_t] = [0, 1, 2].map(|q| {
+                let (cold, ..) = summary(times.iter().map(|t| t[q].0).collect());
+                let (warm, ..) = summary(times.iter().map(|t| t[q].1).collect());
+                (cold, warm)
+            });
+            notes.push(format!(
+                "{model}, {name} rays, ns per ray cold / warm (median of {runs}): grid {:.0} / {:.0}, Embree {:.0} / {:.0}, CWBVH {:.0} / {:.0}; waiting for memory (cold − warm): grid {:.0}, Embree {:.0}",
+                grid_t.0,
+                grid_t.1,
+                embree_t.0,
+                embree_t.1,
+                bvh_t.0,
+                bvh_t.1,
+                grid_t.0 - grid_t.1,
+                embree_t.0 - embree_t.1,
+            ));
             if !*occlusion {
                 let mut counts = TraversalCounts::default();
                 let mut hits = 0usize;
@@ -201,8 +261,12 @@ fn main() {
                 }
                 let per_ray = |x: u64| x as f64 / rays.len() as f64;
                 notes.push(format!(
-                    "{model}, {name} rays: {:.1} cells stepped, {:.1} occupied cells visited, {:.1} triangle tests, {:.2} hits per ray",
+                    "{model}, {name} rays: {:.1} cells stepped ({:.1} occupied macrocells entered, {:.1} leaps over empty macrocells, {:.1} over empty cubes of cells, {:.1} plain steps), {:.1} occupied cells visited, {:.1} triangle tests, {:.2} hits per ray",
                     per_ray(counts.cells),
+                    per_ray(counts.macrocell_entries),
+                    per_ray(counts.macrocell_leaps),
+                    per_ray(counts.cell_leaps),
+                    per_ray(counts.plain_steps),
                     per_ray(counts.occupied),
                     per_ray(counts.tests),
                     hits as f64 / rays.len() as f64

@@ -22,6 +22,14 @@ use crate::accel::prefetch::prefetch;
 pub trait TraversalStats {
     /// One cell (or one skipped stretch of empty macrocells) stepped through.
     fn visit_cell(&mut self) {}
+    /// The walk entered an occupied macrocell (and asked for its record).
+    fn enter_macrocell(&mut self) {}
+    /// The walk leapt over a box of empty macrocells ([`super::reach`]).
+    fn leap_macrocells(&mut self) {}
+    /// The walk leapt over an empty cube of cells ([`super::gaps`]).
+    fn leap_cells(&mut self) {}
+    /// The walk stepped from an empty cell to the next one (plain 3D-DDA step).
+    fn step_cell(&mut self) {}
     /// One occupied cell reached (its triangles are then tested).
     fn visit_occupied(&mut self) {}
     /// Ray–triangle tests (the triangles of one block, tested together).
@@ -38,6 +46,14 @@ impl TraversalStats for () {}
 pub struct TraversalCounts {
     /// Cells and skipped stretches of empty macrocells stepped through.
     pub cells: u64,
+    /// Entries into occupied macrocells (each asks for the macrocell's record).
+    pub macrocell_entries: u64,
+    /// Leaps over boxes of empty macrocells.
+    pub macrocell_leaps: u64,
+    /// Leaps over empty cubes of cells.
+    pub cell_leaps: u64,
+    /// Plain steps out of empty cells.
+    pub plain_steps: u64,
     /// Occupied cells reached.
     pub occupied: u64,
     /// Ray–triangle tests.
@@ -49,6 +65,18 @@ pub struct TraversalCounts {
 impl TraversalStats for TraversalCounts {
     fn visit_cell(&mut self) {
         self.cells += 1;
+    }
+    fn enter_macrocell(&mut self) {
+        self.macrocell_entries += 1;
+    }
+    fn leap_macrocells(&mut self) {
+        self.macrocell_leaps += 1;
+    }
+    fn leap_cells(&mut self) {
+        self.cell_leaps += 1;
+    }
+    fn step_cell(&mut self) {
+        self.plain_steps += 1;
     }
     fn visit_occupied(&mut self) {
         self.occupied += 1;
@@ -302,10 +330,12 @@ impl OccupiedCells<'_> {
             stats.visit_cell();
             let record = match grid.cells.macrocell_of(walk.cell, self.octant) {
                 Ok(record) => {
+                    stats.enter_macrocell();
                     grid.cells.prefetch_record(record);
                     record
                 }
                 Err(reach) => {
+                    stats.leap_macrocells();
                     if !grid.skip_empty_macrocells(walk, self.ray, self.octant, reach) {
                         self.walk = None;
                         return None;
@@ -321,6 +351,7 @@ impl OccupiedCells<'_> {
                     // A cell next to an occupied one (gap 1) is left by an ordinary step:
                     // cheaper than leaving a cube of one cell.
                     Lookup::EmptyCell { gap } if gap >= 2 => {
+                        stats.leap_cells();
                         if !grid.skip_empty_cells(walk, self.ray, gap) {
                             self.walk = None;
                             return None;
@@ -340,6 +371,7 @@ impl OccupiedCells<'_> {
                     }
                     // (`lookup_in` never answers `EmptyMacrocell`.)
                     Lookup::EmptyCell { .. } | Lookup::EmptyMacrocell => {
+                        stats.step_cell();
                         if !walk.advance().1 {
                             self.walk = None;
                             return None;
@@ -352,5 +384,68 @@ impl OccupiedCells<'_> {
                 stats.visit_cell();
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::accel::Triangle;
+
+    /// A sphere of radius 1 at the origin, `n` × 2`n` quads split in two.
+    fn sphere(n: usize) -> Vec<Triangle> {
+        let at = |i: usize, j: usize| {
+            let (theta, phi) = (
+                std::f32::consts::PI * i as f32 / n as f32,
+                std::f32::consts::TAU * j as f32 / (2 * n) as f32,
+            );
+            Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            )
+        };
+        (0..n)
+            .flat_map(|i| (0..2 * n).map(move |j| (i, j)))
+            .flat_map(|(i, j)| {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                [Triangle::new(a, b, c), Triangle::new(a, c, d)]
+            })
+            .collect()
+    }
+
+    /// Every kind of step is counted where the walk takes it: a step of the cell count is
+    /// either an entry into an occupied macrocell, a leap over empty macrocells, or a move
+    /// within a macrocell by a leap over empty cells or a plain step.
+    #[test]
+    fn the_walk_counts_each_kind_of_step() {
+        let grid = Grid::build(sphere(60));
+        let mut total = TraversalCounts::default();
+        for k in 0..400 {
+            let a = k as f32 * 0.7;
+            let origin = Vec3::new(3.0 * a.cos(), 0.01 * k as f32 - 2.0, 3.0 * a.sin());
+            // Half aimed at the sphere, half passing beside it.
+            let target = Vec3::new(0.0, 0.0, if k % 2 == 0 { 0.0 } else { 1.3 });
+            let ray = Ray::new(origin, (target - origin).normalize());
+            let mut counts = TraversalCounts::default();
+            grid.intersect_counting(&ray, &mut counts);
+            let outer = counts.macrocell_entries + counts.macrocell_leaps;
+            assert!(counts.cells >= outer, "ray {k}: {counts:?}");
+            assert!(
+                counts.cells <= outer + counts.cell_leaps + counts.plain_steps,
+                "ray {k}: {counts:?}"
+            );
+            total.macrocell_entries += counts.macrocell_entries;
+            total.macrocell_leaps += counts.macrocell_leaps;
+            total.cell_leaps += counts.cell_leaps;
+            total.plain_steps += counts.plain_steps;
+        }
+        assert!(
+            total.macrocell_entries > 0 && total.macrocell_leaps > 0,
+            "{total:?}"
+        );
+        assert!(total.cell_leaps > 0 && total.plain_steps > 0, "{total:?}");
     }
 }
