@@ -3,12 +3,13 @@
 //! The cells are grouped in macrocells of 8³. One word per macrocell says either where its
 //! record is, or — for an empty macrocell — how far empty space reaches from it towards
 //! each octant of directions ([`super::reach`]), so the walk can leap over a whole box of
-//! empty macrocells. A record holds the 512 occupancy bits of its cells, the ranks and the
-//! cells' gaps ([`super::gaps`]), together so that entering the macrocell asks for all of
-//! them at once. Occupied cells are numbered macrocell by macrocell, so an occupied cell's
-//! number is its word's rank plus a popcount within one 64-bit word, and the offsets of the
-//! cells of one macrocell lie together. A ray stepping through a macrocell thus reads one
-//! record instead of occupancy words scattered over whole rows of the grid.
+//! empty macrocells. A record holds the 512 occupancy bits of its cells, the ranks, and
+//! for each octant how far empty space reaches from each cell ([`super::cell_reach`]); a
+//! ray entering the macrocell asks for the occupancy, the ranks and its own octant's
+//! reaches at once. Occupied cells are numbered macrocell by macrocell, so an occupied
+//! cell's number is its word's rank plus a popcount within one 64-bit word, and the offsets
+//! of the cells of one macrocell lie together. A ray stepping through a macrocell thus reads
+//! one record instead of occupancy words scattered over whole rows of the grid.
 
 use std::ops::Range;
 
@@ -16,7 +17,7 @@ use glam::{IVec3, UVec3};
 use rayon::prelude::*;
 
 use super::box_counts::BoxCounts;
-use super::gaps::Gaps;
+use super::cell_reach::{self, CellReaches, OctantReaches};
 use super::reach::{self, MAX_REACH};
 
 /// A macrocell is 2^MACRO_SHIFT cells along each axis.
@@ -29,16 +30,17 @@ pub(super) const MACRO_CELLS: usize = 1 << (3 * MACRO_SHIFT);
 const EMPTY: u64 = 1 << 63;
 
 /// What the walk needs to know about one occupied macrocell, in one place so that entering
-/// the macrocell can ask for all of it at once: the occupancy of its 512 cells (x fastest,
-/// then y, then z), per word of those bits the number of the word's first occupied cell (so
-/// an occupied cell's number is one popcount away, with no loop over words), and each
-/// cell's distance to the nearest occupied cell.
+/// the macrocell can ask for what a ray needs at once: per octant, how far empty space
+/// reaches from each cell (256 bytes, four cache lines, first so that each octant's lines
+/// are whole), the occupancy of its 512 cells (x fastest, then y, then z), and per word of
+/// those bits the number of the word's first occupied cell (so an occupied cell's number is
+/// one popcount away, with no loop over words).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(C, align(128))]
+#[repr(C, align(64))]
 struct Record {
+    reaches: OctantReaches,
     bits: [u64; MACRO_CELLS / 64],
     ranks: [u32; MACRO_CELLS / 64],
-    gaps: Gaps,
 }
 
 /// What the index says about one cell.
@@ -46,9 +48,10 @@ pub(super) enum Lookup {
     /// The cell's macrocell is empty (how far empty space reaches from it is
     /// [`CellIndex::macrocell_of`]'s answer).
     EmptyMacrocell,
-    /// The cell is empty (its macrocell is not), and so is every cell within Chebyshev
-    /// distance `gap − 1` of it.
-    EmptyCell { gap: u32 },
+    /// The cell is empty (its macrocell is not), and so is the cube of `reach` cells a
+    /// side that has it as a corner and extends towards the octant asked about
+    /// ([`super::cell_reach`]).
+    EmptyCell { reach: u32 },
     /// The cell's blocks.
     Blocks(Range<usize>),
 }
@@ -121,13 +124,17 @@ impl CellIndex {
         }
         index.offsets.push(total);
         index.fill_reaches();
-        let gaps = index.gaps_of(&occupancy);
+        let reaches = index.cell_reaches_of(&occupancy);
         index.first_cells = ranks.iter().map(|r| r[0]).collect();
         index.records = occupancy
             .into_iter()
             .zip(ranks)
-            .zip(gaps)
-            .map(|((bits, ranks), gaps)| Record { bits, ranks, gaps })
+            .zip(reaches)
+            .map(|((bits, ranks), reaches)| Record {
+                reaches,
+                bits,
+                ranks,
+            })
             .collect();
         index
     }
@@ -156,9 +163,9 @@ impl CellIndex {
         })
     }
 
-    /// The cell gaps ([`Gaps`]) of each occupied macrocell, given the occupancy bits of
-    /// each, in parallel over them.
-    fn gaps_of(&self, occupancy: &[[u64; MACRO_CELLS / 64]]) -> Vec<Gaps> {
+    /// The cells' reaches ([`CellReaches`]) of each occupied macrocell, given the occupancy
+    /// bits of each, in parallel over them.
+    fn cell_reaches_of(&self, occupancy: &[[u64; MACRO_CELLS / 64]]) -> Vec<OctantReaches> {
         let m = self.macro_resolution.as_ivec3();
         let mut at = vec![IVec3::ZERO; occupancy.len()];
         for (c, word) in self.macrocells() {
@@ -169,7 +176,7 @@ impl CellIndex {
         let index = self;
         at.par_iter()
             .map(|&c| {
-                Gaps::of(|dx, dy, dz| {
+                CellReaches::of(|dx, dy, dz| {
                     let n = c + IVec3::new(dx, dy, dz);
                     if n.cmplt(IVec3::ZERO).any() || n.cmpge(m).any() {
                         return None;
@@ -187,12 +194,12 @@ impl CellIndex {
         (m.x as u32 + r.x * (m.y as u32 + r.y * m.z as u32)) as usize
     }
 
-    /// What the index says about cell `c` (inside the grid).
+    /// What the index says about cell `c` (inside the grid) to a ray moving into `octant`.
     #[inline(always)]
-    pub fn lookup(&self, c: IVec3) -> Lookup {
-        match self.macrocell_of(c, 0) {
+    pub fn lookup(&self, c: IVec3, octant: u32) -> Lookup {
+        match self.macrocell_of(c, octant) {
             Err(_) => Lookup::EmptyMacrocell,
-            Ok(record) => self.lookup_in(record, c),
+            Ok(record) => self.lookup_in(record, c, octant),
         }
     }
 
@@ -208,28 +215,33 @@ impl CellIndex {
         }
     }
 
-    /// Starts loading all of record `record` (its occupancy, ranks and gaps) and the first
-    /// two cache lines of its cells' offsets at once: the walk has just entered its
-    /// macrocell and will read several parts of them, one after another.
+    /// Starts loading what a ray moving into `octant` reads of record `record` (its
+    /// occupancy, ranks and that octant's reaches) and the first two cache lines of its
+    /// cells' offsets at once: the walk has just entered its macrocell and will read
+    /// several parts of them, one after another.
     #[inline(always)]
-    pub fn prefetch_record(&self, record: usize) {
+    pub fn prefetch_record(&self, record: usize, octant: u32) {
         use crate::accel::prefetch::prefetch;
-        prefetch(&self.records[record]);
+        let r = &self.records[record];
+        prefetch(&r.reaches[octant as usize]);
+        prefetch(&r.bits);
+        prefetch(&r.ranks);
         let first = self.first_cells[record] as usize;
         prefetch(&self.offsets[first]);
         prefetch(&self.offsets[(first + 16).min(self.offsets.len() - 1)]);
     }
 
-    /// What record `record` says about its cell `c`: `EmptyCell` or `Blocks`.
+    /// What record `record` says about its cell `c` to a ray moving into `octant`:
+    /// `EmptyCell` or `Blocks`.
     #[inline(always)]
-    pub fn lookup_in(&self, record: usize, c: IVec3) -> Lookup {
+    pub fn lookup_in(&self, record: usize, c: IVec3, octant: u32) -> Lookup {
         let l = local_index(c & IVec3::splat((1 << MACRO_SHIFT) - 1));
         let record = &self.records[record];
         let bits = record.bits[l >> 6];
         let bit = 1u64 << (l & 63);
         if bits & bit == 0 {
             return Lookup::EmptyCell {
-                gap: record.gaps.get(l),
+                reach: record.reaches[octant as usize].get(l),
             };
         }
         let k = (record.ranks[l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
@@ -307,41 +319,37 @@ impl CellIndex {
                 }
             }
         }
-        self.validate_gaps(resolution)
+        self.validate_cell_reaches(resolution)
     }
 }
 
 impl CellIndex {
-    /// Checks every stored gap against a count of occupied cells in boxes
-    /// ([`BoxCounts`]): the cube of cells within `gap − 1` holds none, and (below the cap)
-    /// the cube within `gap` holds one.
-    fn validate_gaps(&self, resolution: UVec3) -> Result<(), String> {
+    /// Checks every stored cell reach against a count of occupied cells in boxes
+    /// ([`BoxCounts`]): the cube it promises holds none, and (below the cap) the cube one
+    /// cell larger holds one.
+    fn validate_cell_reaches(&self, resolution: UVec3) -> Result<(), String> {
         let r = resolution.as_ivec3();
-        let counts = BoxCounts::new(r, |c| {
-            !matches!(
-                self.lookup(c),
-                Lookup::EmptyMacrocell | Lookup::EmptyCell { .. }
-            )
-        });
-        // Occupied cells within Chebyshev distance `reach` of `c`.
-        let around = |c: IVec3, reach: i32| counts.count(c - reach, c + reach);
+        let counts = BoxCounts::new(r, |c| matches!(self.lookup(c, 0), Lookup::Blocks(_)));
         for z in 0..r.z {
             for y in 0..r.y {
                 for x in 0..r.x {
                     let c = IVec3::new(x, y, z);
-                    let Lookup::EmptyCell { gap } = self.lookup(c) else {
-                        continue;
-                    };
-                    let gap = gap as i32;
-                    if gap < 1 || around(c, gap - 1) != 0 {
-                        return Err(format!(
-                            "cell {c} has gap {gap}, but an occupied cell is nearer"
-                        ));
-                    }
-                    if gap <= i32::from(super::gaps::MAX_RADIUS) && around(c, gap) == 0 {
-                        return Err(format!(
-                            "cell {c} has gap {gap}, but no occupied cell is that near"
-                        ));
+                    for octant in 0..8 {
+                        let Lookup::EmptyCell { reach: k } = self.lookup(c, octant) else {
+                            continue;
+                        };
+                        let (lo, hi) = reach::reach_box(c, octant, k);
+                        if k < 1 || counts.count(lo, hi) != 0 {
+                            return Err(format!(
+                                "cell {c} reaches {k} towards octant {octant}, past an occupied cell"
+                            ));
+                        }
+                        let (lo, hi) = reach::reach_box(c, octant, k + 1);
+                        if k < cell_reach::MAX_REACH && counts.count(lo, hi) == 0 {
+                            return Err(format!(
+                                "cell {c} reaches only {k} towards octant {octant}"
+                            ));
+                        }
                     }
                 }
             }

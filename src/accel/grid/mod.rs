@@ -7,16 +7,16 @@
 //! triangles copied in blocks of eight, vertex and edges lane by lane, cell after cell, so
 //! a cell's triangles are one contiguous read and are tested eight at a time ([`block`]).
 //! Empty macrocells know how far empty space reaches from them towards each octant of
-//! directions ([`reach`]), and empty cells of occupied macrocells their distance to the
-//! nearest occupied cell ([`gaps`]), so the walk leaps over empty space. Traversal is the
+//! directions ([`reach`]), and empty cells of occupied macrocells the same at the level of
+//! cells ([`cell_reach`]), so the walk leaps over empty space. Traversal is the
 //! 3D-DDA of Amanatides & Woo (1987), accepting a hit only if it lies within the current
 //! cell.
 
 mod block;
 mod box_counts;
 mod build;
+mod cell_reach;
 mod cells;
-mod gaps;
 mod overlap;
 mod reach;
 mod traverse;
@@ -140,7 +140,7 @@ impl Grid {
             for y in 0..self.frame.resolution.y {
                 for x in 0..self.frame.resolution.x {
                     let c = UVec3::new(x, y, z);
-                    let Lookup::Blocks(range) = self.cells.lookup(c.as_ivec3()) else {
+                    let Lookup::Blocks(range) = self.cells.lookup(c.as_ivec3(), 0) else {
                         continue;
                     };
                     let lo = self.frame.bounds.min + c.as_vec3() * self.frame.cell_size;

@@ -45,8 +45,8 @@ fn signs(octant: u32) -> IVec3 {
     )
 }
 
-/// The empty box of macrocells `(lo, hi)` (inclusive) that `reach` promises from
-/// macrocell `m`, its corner, for a walk moving into `octant`.
+/// The empty box `(lo, hi)` (inclusive) that `reach` promises from `m`, its corner, for a
+/// walk moving into `octant`: of macrocells here, of cells for [`super::cell_reach`].
 pub(super) fn reach_box(m: IVec3, octant: u32, reach: u32) -> (IVec3, IVec3) {
     let far = m + signs(octant) * (reach as i32 - 1);
     (m.min(far), m.max(far))

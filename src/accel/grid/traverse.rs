@@ -1,9 +1,9 @@
 //! Ray traversal: the 3D-DDA of Amanatides & Woo (1987), "A fast voxel traversal algorithm
 //! for ray tracing", over the two-level cell index ([`super::cells`]): an empty macrocell
 //! sends the walk past the whole empty box ahead of it in one step ([`super::reach`]), an
-//! empty cell past the empty cube around it if it is two or more cells from any occupied
-//! one ([`super::gaps`]), any other empty cell costs a bit test and a step, and an occupied
-//! cell's blocks are tested eight triangles at a time. A grid of one cell is not walked:
+//! empty cell past the empty cube ahead of it if that is two or more cells a side
+//! ([`super::cell_reach`]), any other empty cell costs a bit test and a step, and an
+//! occupied cell's blocks are tested eight triangles at a time. A grid of one cell is not walked:
 //! its blocks are tested at once.
 
 use std::ops::Range;
@@ -26,7 +26,7 @@ pub trait TraversalStats {
     fn enter_macrocell(&mut self) {}
     /// The walk leapt over a box of empty macrocells ([`super::reach`]).
     fn leap_macrocells(&mut self) {}
-    /// The walk leapt over an empty cube of cells ([`super::gaps`]).
+    /// The walk leapt over an empty cube of cells ([`super::cell_reach`]).
     fn leap_cells(&mut self) {}
     /// The walk stepped from an empty cell to the next one (plain 3D-DDA step).
     fn step_cell(&mut self) {}
@@ -212,15 +212,14 @@ impl Grid {
         self.skip_cube(walk, ray, lo, hi)
     }
 
-    /// Moves the walk past the empty cube of cells around its current cell (of Chebyshev
-    /// radius `gap − 1`, `gap` ≥ 2). False when the ray leaves the grid first.
+    /// Moves the walk past the empty cube of `reach` cells a side that has its current cell
+    /// as a corner and extends towards `octant` ([`super::cell_reach`]). False when the ray
+    /// leaves the grid first.
     #[inline(always)]
-    fn skip_empty_cells(&self, walk: &mut CellWalk, ray: &Ray, gap: u32) -> bool {
+    fn skip_empty_cells(&self, walk: &mut CellWalk, ray: &Ray, octant: u32, reach: u32) -> bool {
         let res = self.frame.resolution.as_ivec3();
-        let reach = gap as i32 - 1;
-        let lo = (walk.cell - reach).max(IVec3::ZERO);
-        let hi = (walk.cell + reach).min(res - 1);
-        self.skip_cube(walk, ray, lo, hi)
+        let (lo, hi) = reach::reach_box(walk.cell, octant, reach);
+        self.skip_cube(walk, ray, lo.max(IVec3::ZERO), hi.min(res - 1))
     }
 
     /// Moves the walk out of the empty box of cells `lo..=hi` (which holds the current
@@ -331,7 +330,7 @@ impl OccupiedCells<'_> {
             let record = match grid.cells.macrocell_of(walk.cell, self.octant) {
                 Ok(record) => {
                     stats.enter_macrocell();
-                    grid.cells.prefetch_record(record);
+                    grid.cells.prefetch_record(record, self.octant);
                     record
                 }
                 Err(reach) => {
@@ -347,12 +346,12 @@ impl OccupiedCells<'_> {
             // leaves it: no macrocell lookup per cell.
             let macrocell = walk.cell >> MACRO_SHIFT;
             loop {
-                match grid.cells.lookup_in(record, walk.cell) {
-                    // A cell next to an occupied one (gap 1) is left by an ordinary step:
-                    // cheaper than leaving a cube of one cell.
-                    Lookup::EmptyCell { gap } if gap >= 2 => {
+                match grid.cells.lookup_in(record, walk.cell, self.octant) {
+                    // A cell whose reach is 1 is left by an ordinary step: cheaper than
+                    // leaving a cube of one cell.
+                    Lookup::EmptyCell { reach } if reach >= 2 => {
                         stats.leap_cells();
-                        if !grid.skip_empty_cells(walk, self.ray, gap) {
+                        if !grid.skip_empty_cells(walk, self.ray, self.octant, reach) {
                             self.walk = None;
                             return None;
                         }

@@ -1,0 +1,226 @@
+//! How far empty space reaches ahead of a ray from each empty cell of an occupied
+//! macrocell: for each of the eight octants of directions, the side (in cells, up to
+//! [`MAX_REACH`]) of the largest cube of empty cells that has the cell as a corner and
+//! extends in that octant's directions — the octant reaches of [`super::reach`], one level
+//! down. Most of a walk's steps are through empty cells of macrocells a surface passes
+//! through; a ray moving into the octant stays in the cube until it crosses one of its far
+//! faces, so the walk leaves the whole cube in one step. Unlike a distance to the nearest
+//! occupied cell (proximity clouds, Cohen & Sheffer 1994, which this replaces), the cube is
+//! bounded only by what lies ahead, not by the surface the ray has just left or passes.
+//!
+//! Computed per macrocell and octant on rows of bits over the macrocell and its neighbours
+//! towards the octant: the cells whose cube of side k + 1 is empty are those whose cubes of
+//! side k at the cell and at its seven neighbours towards the octant are all empty — three
+//! `and`s per row (along x, then y, then z) per side.
+
+use super::cells::MACRO_CELLS;
+
+/// Cells along a macrocell's edge.
+const SIDE: usize = 8;
+/// The window a macrocell's reaches are found in: it and one macrocell on every side.
+const WINDOW: usize = 3 * SIDE;
+/// Reaches are found up to this side; a cube of side `MAX_REACH` from any cell of the
+/// macrocell stays within the macrocell and its neighbours towards the octant.
+pub(super) const MAX_REACH: u32 = SIDE as u32;
+
+/// One octant's reach per cell of a macrocell, two to a byte (cell `l` in byte `l / 2`,
+/// the low nibble for even `l`); 0 for an occupied cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(64))]
+pub(super) struct CellReaches([u8; MACRO_CELLS / 2]);
+
+/// Per octant (as [`super::reach::octant`] numbers them), the reaches of a macrocell's
+/// cells.
+pub(super) type OctantReaches = [CellReaches; 8];
+
+impl CellReaches {
+    /// The reach of cell `l` (its index within the macrocell).
+    #[inline(always)]
+    pub fn get(&self, l: usize) -> u32 {
+        u32::from(self.0[l >> 1] >> ((l & 1) * 4)) & 0xf
+    }
+
+    /// The reaches of a macrocell's cells in every octant, from the occupancy of it and its
+    /// neighbours: `neighbour(dx, dy, dz)` (each −1, 0 or 1) gives a neighbour's occupancy
+    /// words (bit `x + 8y` of word `z` for its cell (x, y, z)), `None` where it is empty or
+    /// outside the grid (outside counts as empty: a ray there has left the grid).
+    pub fn of(neighbour: impl Fn(i32, i32, i32) -> Option<[u64; SIDE]>) -> OctantReaches {
+        // Empty cells of the 24³ window as rows along x: empty[z][y], bit x.
+        let mut empty = [[(1u32 << WINDOW) - 1; WINDOW]; WINDOW];
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let Some(words) = neighbour(dx, dy, dz) else {
+                        continue;
+                    };
+                    let (ox, oy, oz) = (
+                        (dx + 1) as usize * SIDE,
+                        (dy + 1) as usize * SIDE,
+                        (dz + 1) as usize * SIDE,
+                    );
+                    for (z, word) in words.iter().enumerate() {
+                        for y in 0..SIDE {
+                            let row = ((word >> (8 * y)) & 0xff) as u32;
+                            empty[oz + z][oy + y] &= !(row << ox);
+                        }
+                    }
+                }
+            }
+        }
+        std::array::from_fn(|octant| reaches_towards(&empty, octant as u32))
+    }
+}
+
+/// The reaches towards `octant` of the central macrocell's cells, given the window's empty
+/// cells.
+fn reaches_towards(empty: &[[u32; WINDOW]; WINDOW], octant: u32) -> CellReaches {
+    let up = [octant & 1 == 0, octant & 2 == 0, octant & 4 == 0];
+    // Only the central macrocell and the macrocells beside it towards the octant matter:
+    // rows and planes `lo..lo + 2·SIDE` in y and z.
+    let lo = |a: usize| if up[a] { SIDE } else { 0 };
+    let (y0, z0) = (lo(1), lo(2));
+    let mut cubes = [[0u32; 2 * SIDE]; 2 * SIDE];
+    for (z, plane) in cubes.iter_mut().enumerate() {
+        for (y, row) in plane.iter_mut().enumerate() {
+            *row = empty[z0 + z][y0 + y];
+        }
+    }
+    // Nibble counters, one per cell of a central row: the number of sides k whose cube
+    // is empty (the cubes are nested, so that number is the reach).
+    let mut counts = [[0u32; SIDE]; SIDE];
+    let (cy, cz) = (SIDE - y0, SIDE - z0);
+    let mut add = |cubes: &[[u32; 2 * SIDE]; 2 * SIDE]| {
+        for (z, plane) in counts.iter_mut().enumerate() {
+            for (y, count) in plane.iter_mut().enumerate() {
+                *count += spread((cubes[cz + z][cy + y] >> SIDE) & 0xff);
+            }
+        }
+    };
+    add(&cubes);
+    for _ in 1..MAX_REACH {
+        grow(&mut cubes, up);
+        add(&cubes);
+    }
+    let mut reaches = [0u8; MACRO_CELLS / 2];
+    for (z, plane) in counts.iter().enumerate() {
+        for (y, count) in plane.iter().enumerate() {
+            let at = (SIDE * (y + SIDE * z)) / 2;
+            reaches[at..at + 4].copy_from_slice(&count.to_le_bytes());
+        }
+    }
+    CellReaches(reaches)
+}
+
+/// From the cells whose cube of side k towards the octant (`up` per axis) is empty, those
+/// whose cube of side k + 1 is: the cell's cube and its neighbours' towards the octant
+/// along x, then y, then z. Rows and planes at the far edge keep stale values, which no
+/// central cell's reach up to `MAX_REACH` depends on.
+fn grow(cubes: &mut [[u32; 2 * SIDE]; 2 * SIDE], up: [bool; 3]) {
+    for plane in cubes.iter_mut() {
+        for row in plane.iter_mut() {
+            *row &= if up[0] { *row >> 1 } else { *row << 1 };
+        }
+    }
+    let n = 2 * SIDE;
+    for plane in cubes.iter_mut() {
+        if up[1] {
+            for y in 0..n - 1 {
+                plane[y] &= plane[y + 1];
+            }
+        } else {
+            for y in (1..n).rev() {
+                plane[y] &= plane[y - 1];
+            }
+        }
+    }
+    if up[2] {
+        for z in 0..n - 1 {
+            let next = cubes[z + 1];
+            for (row, above) in cubes[z].iter_mut().zip(next) {
+                *row &= above;
+            }
+        }
+    } else {
+        for z in (1..n).rev() {
+            let next = cubes[z - 1];
+            for (row, below) in cubes[z].iter_mut().zip(next) {
+                *row &= below;
+            }
+        }
+    }
+}
+
+/// The eight bits of `bits` as the eight nibbles of a word, bit `i` to nibble `i`.
+#[inline]
+fn spread(bits: u32) -> u32 {
+    SPREAD[bits as usize]
+}
+
+/// [`spread`] of every byte.
+static SPREAD: [u32; 256] = {
+    let mut table = [0u32; 256];
+    let mut bits = 0;
+    while bits < 256 {
+        let mut i = 0;
+        while i < SIDE {
+            table[bits] |= ((bits as u32 >> i) & 1) << (4 * i);
+            i += 1;
+        }
+        bits += 1;
+    }
+    table
+};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Reaches found by trying every side: the largest cube of empty cells with the cell as
+    /// its corner, towards the octant, within the window (outside it counts as empty).
+    #[test]
+    fn reaches_are_the_largest_empty_cube_towards_each_octant() {
+        let mut rng = crate::render::sampling::Rng::new(5, 5);
+        let mut coordinate = || (rng.next_u32() % WINDOW as u32) as i32 - SIDE as i32;
+        for round in 0..40 {
+            // A few occupied cells scattered over the window, some neighbours empty.
+            let mut occupied = std::collections::HashSet::new();
+            for _ in 0..(1 + round % 12) {
+                occupied.insert([coordinate(), coordinate(), coordinate()]);
+            }
+            let words = |dx: i32, dy: i32, dz: i32| {
+                let mut w = [0u64; SIDE];
+                for &[x, y, z] in &occupied {
+                    let (mx, my, mz) = (x.div_euclid(8), y.div_euclid(8), z.div_euclid(8));
+                    if (mx, my, mz) == (dx, dy, dz) {
+                        let (lx, ly, lz) = (x.rem_euclid(8), y.rem_euclid(8), z.rem_euclid(8));
+                        w[lz as usize] |= 1 << (lx + 8 * ly);
+                    }
+                }
+                w.iter().any(|&b| b != 0).then_some(w)
+            };
+            let reaches = CellReaches::of(words);
+            for (octant, reaches) in reaches.iter().enumerate() {
+                let s = [0, 1, 2].map(|a| if octant >> a & 1 == 0 { 1 } else { -1 });
+                let cube_is_empty = |c: [i32; 3], k: i32| {
+                    !occupied.iter().any(|o| {
+                        (0..3).all(|a| {
+                            let d = (o[a] - c[a]) * s[a];
+                            (0..k).contains(&d)
+                        })
+                    })
+                };
+                for l in 0..MACRO_CELLS {
+                    let c = [(l & 7) as i32, (l >> 3 & 7) as i32, (l >> 6) as i32];
+                    let want = (1..=MAX_REACH as i32)
+                        .take_while(|&k| cube_is_empty(c, k))
+                        .count() as u32;
+                    assert_eq!(
+                        reaches.get(l),
+                        want,
+                        "cell {c:?}, octant {octant}, round {round}"
+                    );
+                }
+            }
+        }
+    }
+}
