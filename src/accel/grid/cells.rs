@@ -305,18 +305,8 @@ impl CellIndex {
             }
             for octant in 0..8 {
                 let k = reach::unpack(word, octant);
-                let (lo, hi) = reach::reach_box(c, octant, k);
-                if k < 1 || macro_counts.count(lo, hi) != 0 {
-                    return Err(format!(
-                        "empty macrocell {c} reaches {k} towards octant {octant}, past an occupied one"
-                    ));
-                }
-                let (lo, hi) = reach::reach_box(c, octant, k + 1);
-                if k < MAX_REACH && macro_counts.count(lo, hi) == 0 {
-                    return Err(format!(
-                        "empty macrocell {c} reaches only {k} towards octant {octant}"
-                    ));
-                }
+                check_reach(&macro_counts, c, octant, k, MAX_REACH)
+                    .map_err(|e| format!("empty macrocell {e}"))?;
             }
         }
         self.validate_cell_reaches(resolution)
@@ -338,24 +328,31 @@ impl CellIndex {
                         let Lookup::EmptyCell { reach: k } = self.lookup(c, octant) else {
                             continue;
                         };
-                        let (lo, hi) = reach::reach_box(c, octant, k);
-                        if k < 1 || counts.count(lo, hi) != 0 {
-                            return Err(format!(
-                                "cell {c} reaches {k} towards octant {octant}, past an occupied cell"
-                            ));
-                        }
-                        let (lo, hi) = reach::reach_box(c, octant, k + 1);
-                        if k < cell_reach::MAX_REACH && counts.count(lo, hi) == 0 {
-                            return Err(format!(
-                                "cell {c} reaches only {k} towards octant {octant}"
-                            ));
-                        }
+                        check_reach(&counts, c, octant, k, cell_reach::MAX_REACH)
+                            .map_err(|e| format!("cell {e}"))?;
                     }
                 }
             }
         }
         Ok(())
     }
+}
+
+/// Checks a reach `k` of `c` (a macrocell or a cell, counted in `counts`) towards
+/// `octant`: the box it promises holds nothing occupied, and — below `cap` — the box one
+/// larger does.
+fn check_reach(counts: &BoxCounts, c: IVec3, octant: u32, k: u32, cap: u32) -> Result<(), String> {
+    let (lo, hi) = reach::reach_box(c, octant, k);
+    if k < 1 || counts.count(lo, hi) != 0 {
+        return Err(format!(
+            "{c} reaches {k} towards octant {octant}, past an occupied one"
+        ));
+    }
+    let (lo, hi) = reach::reach_box(c, octant, k + 1);
+    if k < cap && counts.count(lo, hi) == 0 {
+        return Err(format!("{c} reaches only {k} towards octant {octant}"));
+    }
+    Ok(())
 }
 
 /// Index of a cell within its macrocell, from its coordinates there.
