@@ -14,6 +14,7 @@
 //! `and`s per row (along x, then y, then z) per side.
 
 use super::cells::MACRO_CELLS;
+use super::reach::moves_up;
 
 /// Cells along a macrocell's edge.
 const SIDE: usize = 8;
@@ -74,7 +75,7 @@ impl CellReaches {
 /// The reaches towards `octant` of the central macrocell's cells, given the window's empty
 /// cells.
 fn reaches_towards(empty: &[[u32; WINDOW]; WINDOW], octant: u32) -> CellReaches {
-    let up = [octant & 1 == 0, octant & 2 == 0, octant & 4 == 0];
+    let up = [0, 1, 2].map(|a| moves_up(octant, a));
     // Only the central macrocell and the macrocells beside it towards the octant matter:
     // rows and planes `lo..lo + 2·SIDE` in y and z.
     let lo = |a: usize| if up[a] { SIDE } else { 0 };
@@ -200,7 +201,7 @@ mod tests {
             };
             let reaches = CellReaches::of(words);
             for (octant, reaches) in reaches.iter().enumerate() {
-                let s = [0, 1, 2].map(|a| if octant >> a & 1 == 0 { 1 } else { -1 });
+                let s = [0, 1, 2].map(|a| if moves_up(octant as u32, a) { 1 } else { -1 });
                 let cube_is_empty = |c: [i32; 3], k: i32| {
                     !occupied.iter().any(|o| {
                         (0..3).all(|a| {

@@ -36,13 +36,15 @@ pub(super) fn unpack(word: u64, octant: u32) -> u32 {
     (word >> (BITS * octant)) as u32 & MAX_REACH
 }
 
+/// True when a walk moving into `octant` moves up (or along) `axis` ([`octant`]).
+#[inline(always)]
+pub(super) fn moves_up(octant: u32, axis: usize) -> bool {
+    octant >> axis & 1 == 0
+}
+
 /// The direction of `octant` per axis: +1 or −1.
 fn signs(octant: u32) -> IVec3 {
-    IVec3::new(
-        if octant & 1 != 0 { -1 } else { 1 },
-        if octant & 2 != 0 { -1 } else { 1 },
-        if octant & 4 != 0 { -1 } else { 1 },
-    )
+    IVec3::from_array([0, 1, 2].map(|a| if moves_up(octant, a) { 1 } else { -1 }))
 }
 
 /// The empty box `(lo, hi)` (inclusive) that `reach` promises from `m`, its corner, for a

@@ -3,8 +3,8 @@
 //! sends the walk past the whole empty box ahead of it in one step ([`super::reach`]), an
 //! empty cell past the empty cube ahead of it if that is two or more cells a side
 //! ([`super::cell_reach`]), any other empty cell costs a bit test and a step, and an
-//! occupied cell's blocks are tested eight triangles at a time. A grid of one cell is not walked:
-//! its blocks are tested at once.
+//! occupied cell's blocks are tested eight triangles at a time. A grid of one cell is not
+//! walked: its blocks are tested at once.
 
 use std::ops::Range;
 
