@@ -137,6 +137,10 @@ impl Block {
     #[inline(always)]
     pub fn nearest(&self, ray: &Ray, t_max: f32) -> Option<LaneHit> {
         let (hit, ts, us, vs) = self.test(ray, t_max);
+        // Most blocks tested hold no hit: one test of all lanes then, not one per lane.
+        if !hit.iter().any(|&h| h) {
+            return None;
+        }
         let mut best: Option<LaneHit> = None;
         let mut t_best = t_max;
         for l in 0..LANES {
