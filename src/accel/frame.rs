@@ -116,7 +116,6 @@ impl GridFrame {
             t_next: Vec3A::INFINITY,
             t_end,
             resolution: self.resolution,
-            resolution_f: self.resolution.as_vec3().into(),
         };
         walk.refresh();
         Some(walk)
@@ -152,81 +151,13 @@ pub(crate) struct CellWalk {
     /// Ray parameter at which the ray leaves the grid (or reaches `t_max`).
     pub t_end: f32,
     resolution: UVec3,
-    /// `resolution` as floats.
-    resolution_f: Vec3A,
 }
 
 impl CellWalk {
-    /// 1 on axes the ray moves up, else 0, as floats.
+    /// Parameter of the plane of cell face `face` on `axis` (∞ if the ray is parallel to it).
     #[inline(always)]
-    fn far_side_f(&self) -> Vec3A {
-        self.step_f.max(Vec3A::ZERO)
-    }
-
-    /// The far faces ahead of the ray (per axis, in cell-face coordinates) of the cube of
-    /// `side` cells that has the current cell as its corner and extends the way the ray
-    /// moves: the box [`CellWalk::leap`] leaves.
-    #[inline(always)]
-    pub fn cube_faces(&self, side: u32) -> Vec3A {
-        self.face + self.step_f * (side as f32 - 1.0)
-    }
-
-    /// The same for a cube of `side` blocks of `block` cells a side (the grid cut into such
-    /// blocks from its corner), with the current cell's block as its corner.
-    #[inline(always)]
-    pub fn block_cube_faces(&self, side: u32, block: u32) -> Vec3A {
-        let far_side = self.far_side_f();
-        // Cells are not negative, so truncation is the floor.
-        let corner = truncated((self.face - far_side) * (1.0 / block as f32));
-        (corner + far_side + self.step_f * (side as f32 - 1.0)) * block as f32
-    }
-
-    /// Moves the walk out of an empty box of cells that holds the current cell and whose
-    /// far faces ahead of the ray are `faces` ([`CellWalk::cube_faces`]), to the first
-    /// cell beyond it along `ray` in the grid `frame`. False when the ray leaves the grid
-    /// or reaches its end first.
-    ///
-    /// Branch-free over the axes, on whole-number floats, so each line is one vector
-    /// operation: the exit face comes first, then the cell under the exit point on the
-    /// other axes, kept within the box and never behind the current cell, so rounding
-    /// cannot move the walk backwards or sideways.
-    #[inline(always)]
-    pub fn leap(&mut self, faces: Vec3A, ray: &Ray, frame: &GridFrame) -> bool {
-        let faces = faces.max(Vec3A::ZERO).min(self.resolution_f);
-        let t = self.slope * faces + self.offset;
-        let t_exit = t.min_element();
-        if t_exit >= self.t_end {
-            return false;
-        }
-        // The axis whose face comes first (x before y before z on the rare ties).
-        let mut exit = t.cmpeq(Vec3A::splat(t_exit));
-        if !exit.bitmask().is_power_of_two() {
-            let on_x = t.x <= t.y && t.x <= t.z;
-            let on_y = !on_x && t.y <= t.z;
-            exit = glam::BVec3A::new(on_x, on_y, !on_x && !on_y);
-        }
-        let far_side = self.far_side_f();
-        let cell = self.face - far_side;
-        let last = faces - far_side;
-        let origin = Vec3A::from(ray.origin);
-        let under = ((origin + Vec3A::from(ray.direction) * t_exit)
-            - Vec3A::from(frame.bounds.min))
-            * Vec3A::from(frame.inv_cell_size);
-        // Truncation differs from the floor only below 0, where the clamp decides anyway.
-        let beside = truncated(under).max(cell.min(last)).min(cell.max(last));
-        let moving = self.step_f.cmpne(Vec3A::ZERO);
-        let next = Vec3A::select(
-            exit,
-            faces + far_side - Vec3A::ONE,
-            Vec3A::select(moving, beside, cell),
-        );
-        if (next.cmplt(Vec3A::ZERO) | next.cmpge(self.resolution_f)).any() {
-            return false;
-        }
-        self.cell = next.as_ivec3();
-        self.face = next + far_side;
-        self.t_next = self.slope * self.face + self.offset;
-        true
+    pub fn face_t(&self, axis: usize, face: i32) -> f32 {
+        self.slope[axis] * face as f32 + self.offset[axis]
     }
 
     /// Recomputes where the ray leaves the current cell, on every axis.
@@ -265,21 +196,6 @@ impl CellWalk {
         self.t_next = self.slope * self.face + self.offset;
         (t_exit, true)
     }
-}
-
-/// `v` rounded toward zero, for values well within ±2³¹ (cell coordinates): two
-/// conversions on x86-64, where `floor` without SSE4.1 is a chain of seven dependent
-/// operations on the walk's critical path.
-#[inline(always)]
-fn truncated(v: Vec3A) -> Vec3A {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_mm_cvtepi32_ps, _mm_cvttps_epi32};
-        // SAFETY: SSE2 is part of x86-64.
-        Vec3A::from(unsafe { _mm_cvtepi32_ps(_mm_cvttps_epi32(v.into())) })
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    v.trunc()
 }
 
 #[inline]

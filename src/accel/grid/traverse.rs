@@ -8,7 +8,7 @@
 
 use std::ops::Range;
 
-use glam::UVec3;
+use glam::{IVec3, UVec3};
 
 use super::cells::{Lookup, MACRO_SHIFT};
 use super::reach;
@@ -195,20 +195,79 @@ impl Grid {
     }
 
     /// Moves the walk past the empty cube of macrocells that reaches `reach` macrocells
-    /// from its current one towards the ray's octant ([`reach`]), to the first cell beyond
-    /// it along the ray. False when the ray leaves the grid first.
+    /// from its current one towards `octant` ([`reach`]), to the first cell beyond it along
+    /// the ray. False when the ray leaves the grid first.
     #[inline(always)]
-    fn skip_empty_macrocells(&self, walk: &mut CellWalk, ray: &Ray, reach: u32) -> bool {
-        let faces = walk.block_cube_faces(reach.max(1), 1 << MACRO_SHIFT);
-        walk.leap(faces, ray, &self.frame)
+    fn skip_empty_macrocells(
+        &self,
+        walk: &mut CellWalk,
+        ray: &Ray,
+        octant: u32,
+        reach: u32,
+    ) -> bool {
+        let res = self.frame.resolution.as_ivec3();
+        let (lo, hi) = reach::reach_box(walk.cell >> MACRO_SHIFT, octant, reach.max(1));
+        let lo = (lo << MACRO_SHIFT).max(IVec3::ZERO);
+        let hi = (((hi + 1) << MACRO_SHIFT) - 1).min(res - 1);
+        self.skip_cube(walk, ray, lo, hi)
     }
 
     /// Moves the walk past the empty cube of `reach` cells a side that has its current cell
-    /// as a corner and extends towards the ray's octant ([`super::cell_reach`]). False when
-    /// the ray leaves the grid first.
+    /// as a corner and extends towards `octant` ([`super::cell_reach`]). False when the ray
+    /// leaves the grid first.
     #[inline(always)]
-    fn skip_empty_cells(&self, walk: &mut CellWalk, ray: &Ray, reach: u32) -> bool {
-        walk.leap(walk.cube_faces(reach), ray, &self.frame)
+    fn skip_empty_cells(&self, walk: &mut CellWalk, ray: &Ray, octant: u32, reach: u32) -> bool {
+        let res = self.frame.resolution.as_ivec3();
+        let (lo, hi) = reach::reach_box(walk.cell, octant, reach);
+        self.skip_cube(walk, ray, lo.max(IVec3::ZERO), hi.min(res - 1))
+    }
+
+    /// Moves the walk out of the empty box of cells `lo..=hi` (which holds the current
+    /// cell) to the first cell beyond it along the ray. False when the ray leaves the grid
+    /// first. Inlined into the walk, so that it is compiled with the walk's instruction set
+    /// (otherwise `floor` is a call into libm).
+    #[inline(always)]
+    fn skip_cube(&self, walk: &mut CellWalk, ray: &Ray, lo: IVec3, hi: IVec3) -> bool {
+        let res = self.frame.resolution.as_ivec3();
+        let mut axis = 0;
+        let mut t_exit = f32::INFINITY;
+        for a in 0..3 {
+            let face = if walk.step[a] > 0 { hi[a] + 1 } else { lo[a] };
+            let t = walk.face_t(a, face);
+            if t < t_exit {
+                t_exit = t;
+                axis = a;
+            }
+        }
+        if t_exit >= walk.t_end {
+            return false;
+        }
+        let next = if walk.step[axis] > 0 {
+            hi[axis] + 1
+        } else {
+            lo[axis] - 1
+        };
+        if next < 0 || next >= res[axis] {
+            return false;
+        }
+        // The other axes: the cell under the exit point, kept within the empty box and never
+        // behind the current cell, so rounding cannot move the walk backwards or sideways.
+        let p = ray.at(t_exit);
+        for a in 0..3 {
+            if a == axis {
+                walk.cell[a] = next;
+            } else if walk.step[a] != 0 {
+                let c = ((p[a] - self.frame.bounds.min[a]) * self.frame.inv_cell_size[a]).floor()
+                    as i32;
+                walk.cell[a] = if walk.step[a] > 0 {
+                    c.clamp(walk.cell[a], hi[a])
+                } else {
+                    c.clamp(lo[a], walk.cell[a])
+                };
+            }
+        }
+        walk.refresh();
+        true
     }
 }
 
@@ -276,7 +335,7 @@ impl OccupiedCells<'_> {
                 }
                 Err(reach) => {
                     stats.leap_macrocells();
-                    if !grid.skip_empty_macrocells(walk, self.ray, reach) {
+                    if !grid.skip_empty_macrocells(walk, self.ray, self.octant, reach) {
                         self.walk = None;
                         return None;
                     }
@@ -292,7 +351,7 @@ impl OccupiedCells<'_> {
                     // leaving a cube of one cell.
                     Lookup::EmptyCell { reach } if reach >= 2 => {
                         stats.leap_cells();
-                        if !grid.skip_empty_cells(walk, self.ray, reach) {
+                        if !grid.skip_empty_cells(walk, self.ray, self.octant, reach) {
                             self.walk = None;
                             return None;
                         }
