@@ -195,44 +195,50 @@ impl Grid {
     }
 
     /// Moves the walk past the empty cube of macrocells that reaches `reach` macrocells
-    /// from its current one towards `octant` ([`reach`]), to the first cell beyond it along
-    /// the ray. False when the ray leaves the grid first.
+    /// from its current one in the ray's direction ([`reach`]), to the first cell beyond
+    /// it along the ray. False when the ray leaves the grid first.
     #[inline(always)]
-    fn skip_empty_macrocells(
-        &self,
-        walk: &mut CellWalk,
-        ray: &Ray,
-        octant: u32,
-        reach: u32,
-    ) -> bool {
+    fn skip_empty_macrocells(&self, walk: &mut CellWalk, ray: &Ray, reach: u32) -> bool {
         let res = self.frame.resolution.as_ivec3();
-        let (lo, hi) = reach::reach_box(walk.cell >> MACRO_SHIFT, octant, reach.max(1));
-        let lo = (lo << MACRO_SHIFT).max(IVec3::ZERO);
-        let hi = (((hi + 1) << MACRO_SHIFT) - 1).min(res - 1);
-        self.skip_cube(walk, ray, lo, hi)
+        let m = walk.cell >> MACRO_SHIFT;
+        let r = reach.max(1) as i32;
+        let mut last = IVec3::ZERO;
+        for a in 0..3 {
+            last[a] = if walk.step[a] < 0 {
+                ((m[a] - r + 1) << MACRO_SHIFT).max(0)
+            } else {
+                (((m[a] + r) << MACRO_SHIFT) - 1).min(res[a] - 1)
+            };
+        }
+        self.skip_cube(walk, ray, last)
     }
 
     /// Moves the walk past the empty cube of `reach` cells a side that has its current cell
-    /// as a corner and extends towards `octant` ([`super::cell_reach`]). False when the ray
-    /// leaves the grid first.
+    /// as a corner and extends in the ray's direction ([`super::cell_reach`]). False when
+    /// the ray leaves the grid first.
     #[inline(always)]
-    fn skip_empty_cells(&self, walk: &mut CellWalk, ray: &Ray, octant: u32, reach: u32) -> bool {
+    fn skip_empty_cells(&self, walk: &mut CellWalk, ray: &Ray, reach: u32) -> bool {
         let res = self.frame.resolution.as_ivec3();
-        let (lo, hi) = reach::reach_box(walk.cell, octant, reach);
-        self.skip_cube(walk, ray, lo.max(IVec3::ZERO), hi.min(res - 1))
+        let last = (walk.cell + walk.step * (reach as i32 - 1)).clamp(IVec3::ZERO, res - 1);
+        self.skip_cube(walk, ray, last)
     }
 
-    /// Moves the walk out of the empty box of cells `lo..=hi` (which holds the current
-    /// cell) to the first cell beyond it along the ray. False when the ray leaves the grid
-    /// first. Inlined into the walk, so that it is compiled with the walk's instruction set
-    /// (otherwise `floor` is a call into libm).
+    /// Moves the walk out of the empty box of cells from its current cell to the cell
+    /// `last` ahead along each axis the ray moves on, to the first cell beyond it along the
+    /// ray. False when the ray leaves the grid first. (An axis the ray is parallel to is
+    /// never left: its face lies at ∞.) Inlined into the walk, so that it is compiled with
+    /// the walk's instruction set (otherwise `floor` is a call into libm).
     #[inline(always)]
-    fn skip_cube(&self, walk: &mut CellWalk, ray: &Ray, lo: IVec3, hi: IVec3) -> bool {
+    fn skip_cube(&self, walk: &mut CellWalk, ray: &Ray, last: IVec3) -> bool {
         let res = self.frame.resolution.as_ivec3();
         let mut axis = 0;
         let mut t_exit = f32::INFINITY;
         for a in 0..3 {
-            let face = if walk.step[a] > 0 { hi[a] + 1 } else { lo[a] };
+            let face = if walk.step[a] > 0 {
+                last[a] + 1
+            } else {
+                last[a]
+            };
             let t = walk.face_t(a, face);
             if t < t_exit {
                 t_exit = t;
@@ -242,11 +248,7 @@ impl Grid {
         if t_exit >= walk.t_end {
             return false;
         }
-        let next = if walk.step[axis] > 0 {
-            hi[axis] + 1
-        } else {
-            lo[axis] - 1
-        };
+        let next = last[axis] + walk.step[axis];
         if next < 0 || next >= res[axis] {
             return false;
         }
@@ -260,9 +262,9 @@ impl Grid {
                 let c = ((p[a] - self.frame.bounds.min[a]) * self.frame.inv_cell_size[a]).floor()
                     as i32;
                 walk.cell[a] = if walk.step[a] > 0 {
-                    c.clamp(walk.cell[a], hi[a])
+                    c.clamp(walk.cell[a], last[a])
                 } else {
-                    c.clamp(lo[a], walk.cell[a])
+                    c.clamp(last[a], walk.cell[a])
                 };
             }
         }
@@ -335,7 +337,7 @@ impl OccupiedCells<'_> {
                 }
                 Err(reach) => {
                     stats.leap_macrocells();
-                    if !grid.skip_empty_macrocells(walk, self.ray, self.octant, reach) {
+                    if !grid.skip_empty_macrocells(walk, self.ray, reach) {
                         self.walk = None;
                         return None;
                     }
@@ -351,7 +353,7 @@ impl OccupiedCells<'_> {
                     // leaving a cube of one cell.
                     Lookup::EmptyCell { reach } if reach >= 2 => {
                         stats.leap_cells();
-                        if !grid.skip_empty_cells(walk, self.ray, self.octant, reach) {
+                        if !grid.skip_empty_cells(walk, self.ray, reach) {
                             self.walk = None;
                             return None;
                         }
