@@ -9,8 +9,8 @@
 //! take turns (in rotating order), each keeping the best of 7 repeats, so drifts of the
 //! machine's speed touch all three alike. That is one run; the ratios are reported as the
 //! median and the range over 5 runs. Then the grid's own counters per ray, each query's
-//! time per ray with caches cold and warm ([`cold_and_warm`]), and the grid's speed-up on
-//! all threads.
+//! time per ray with caches cold and warm ([`cold_and_warm`]), the grid's time split
+//! between its walk and its triangles ([`Grid::walk`]), and its speed-up on all threads.
 //!
 //! Run with `cargo bench --bench accel` after `tools/setup-dev.sh`. Environment:
 //! `ACCEL_BENCH_MODELS` (comma-separated files of data/dragon, default the smallest, a
@@ -99,6 +99,32 @@ fn run_once(rays: &[Ray], queries: &[Query], run: usize) -> Vec<f64> {
         .iter()
         .map(|t| rays.len() as f64 / t.as_secs_f64() / 1e6)
         .collect()
+}
+
+/// The grid's time per ray split between its walk and its triangles, ns per ray of the
+/// query and of the walk alone to where the query's hit lies (`stops`, [`Grid::walk`]),
+/// each chunk timed as in [`run_once`] (best of `REPEATS`, the two in rotating order).
+fn walk_split(grid: &Grid, rays: &[Ray], stops: &[f32], run: usize) -> (f64, f64) {
+    let mut total = [Duration::ZERO; 2];
+    for (c, (chunk, stops)) in rays.chunks(CHUNK).zip(stops.chunks(CHUNK)).enumerate() {
+        for k in 0..2 {
+            let q = (k + c + run) % 2;
+            let best = (0..REPEATS)
+                .map(|_| {
+                    let (visited, t) = timed(|| match q {
+                        0 => chunk.iter().filter(|r| grid.intersect(r).is_some()).count(),
+                        _ => chunk.iter().zip(stops).map(|(r, &s)| grid.walk(r, s)).sum(),
+                    });
+                    std::hint::black_box(visited);
+                    t
+                })
+                .min()
+                .unwrap();
+            total[q] += best;
+        }
+    }
+    let per_ray = |t: Duration| t.as_secs_f64() * 1e9 / rays.len() as f64;
+    (per_ray(total[0]), per_ray(total[1]))
 }
 
 /// How many times in a row each ray is traced for the warm figure.
@@ -254,6 +280,20 @@ fn main() {
                 embree_t.0 - embree_t.1,
             ));
             if !*occlusion {
+                let stops: Vec<f32> = rays
+                    .iter()
+                    .map(|r| grid.intersect(r).map_or(f32::INFINITY, |h| h.t))
+                    .collect();
+                let splits: Vec<(f64, f64)> = (0..runs)
+                    .map(|run| walk_split(&grid, rays, &stops, run))
+                    .collect();
+                let (query, ..) = summary(splits.iter().map(|s| s.0).collect());
+                let (walk, ..) = summary(splits.iter().map(|s| s.1).collect());
+                notes.push(format!(
+                    "{model}, {name} rays, grid ns per ray as in the table (median of {runs}): query {query:.0}, of which the walk alone {walk:.0} ({:.0} %), the triangles' reads and tests {:.0}",
+                    100.0 * walk / query,
+                    query - walk
+                ));
                 let mut counts = TraversalCounts::default();
                 let mut hits = 0usize;
                 for r in rays {
