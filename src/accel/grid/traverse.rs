@@ -8,7 +8,7 @@
 
 use std::ops::Range;
 
-use glam::{IVec3, UVec3};
+use glam::UVec3;
 
 use super::cells::{Lookup, MACRO_SHIFT};
 use super::reach;
@@ -16,6 +16,9 @@ use super::{Grid, GridHit};
 use crate::accel::Ray;
 use crate::accel::frame::CellWalk;
 use crate::accel::prefetch::prefetch;
+
+/// Cells along a macrocell's edge, as the unit of [`CellWalk::leave_cube`].
+const MACROCELL_SIDE: f32 = (1 << MACRO_SHIFT) as f32;
 
 /// Counts the work a traversal does, for the benchmark's statistics. The unit type counts
 /// nothing and compiles away.
@@ -213,7 +216,7 @@ impl Grid {
     #[inline(always)]
     fn occupied_cells<'a, const READ_BLOCKS: bool>(
         &'a self,
-        ray: &'a Ray,
+        ray: &Ray,
     ) -> OccupiedCells<'a, READ_BLOCKS> {
         let single_cell = self.frame.resolution == UVec3::ONE;
         let walk = if self.blocks.is_empty() || single_cell {
@@ -223,90 +226,11 @@ impl Grid {
         };
         OccupiedCells {
             grid: self,
-            ray,
             octant: walk.map_or(0, |w| reach::octant(w.step)),
             walk,
             single_cell: single_cell && !self.blocks.is_empty(),
             ahead: None,
         }
-    }
-
-    /// Moves the walk past the empty cube of macrocells that reaches `reach` macrocells
-    /// from its current one in the ray's direction ([`reach`]), to the first cell beyond
-    /// it along the ray. False when the ray leaves the grid first.
-    #[inline(always)]
-    fn skip_empty_macrocells(&self, walk: &mut CellWalk, ray: &Ray, reach: u32) -> bool {
-        let res = self.frame.resolution.as_ivec3();
-        let m = walk.cell >> MACRO_SHIFT;
-        let r = reach.max(1) as i32;
-        let mut last = IVec3::ZERO;
-        for a in 0..3 {
-            last[a] = if walk.step[a] < 0 {
-                ((m[a] - r + 1) << MACRO_SHIFT).max(0)
-            } else {
-                (((m[a] + r) << MACRO_SHIFT) - 1).min(res[a] - 1)
-            };
-        }
-        self.skip_cube(walk, ray, last)
-    }
-
-    /// Moves the walk past the empty cube of `reach` cells a side that has its current cell
-    /// as a corner and extends in the ray's direction ([`super::cell_reach`]). False when
-    /// the ray leaves the grid first.
-    #[inline(always)]
-    fn skip_empty_cells(&self, walk: &mut CellWalk, ray: &Ray, reach: u32) -> bool {
-        let res = self.frame.resolution.as_ivec3();
-        let last = (walk.cell + walk.step * (reach as i32 - 1)).clamp(IVec3::ZERO, res - 1);
-        self.skip_cube(walk, ray, last)
-    }
-
-    /// Moves the walk out of the empty box of cells from its current cell to the cell
-    /// `last` ahead along each axis the ray moves on, to the first cell beyond it along the
-    /// ray. False when the ray leaves the grid first. (An axis the ray is parallel to is
-    /// never left: its face lies at ∞.) Inlined into the walk, so that it is compiled with
-    /// the walk's instruction set (otherwise `floor` is a call into libm).
-    #[inline(always)]
-    fn skip_cube(&self, walk: &mut CellWalk, ray: &Ray, last: IVec3) -> bool {
-        let res = self.frame.resolution.as_ivec3();
-        let mut axis = 0;
-        let mut t_exit = f32::INFINITY;
-        for a in 0..3 {
-            let face = if walk.step[a] > 0 {
-                last[a] + 1
-            } else {
-                last[a]
-            };
-            let t = walk.face_t(a, face);
-            if t < t_exit {
-                t_exit = t;
-                axis = a;
-            }
-        }
-        if t_exit >= walk.t_end {
-            return false;
-        }
-        let next = last[axis] + walk.step[axis];
-        if next < 0 || next >= res[axis] {
-            return false;
-        }
-        // The other axes: the cell under the exit point, kept within the empty box and never
-        // behind the current cell, so rounding cannot move the walk backwards or sideways.
-        let p = ray.at(t_exit);
-        for a in 0..3 {
-            if a == axis {
-                walk.cell[a] = next;
-            } else if walk.step[a] != 0 {
-                let c = ((p[a] - self.frame.bounds.min[a]) * self.frame.inv_cell_size[a]).floor()
-                    as i32;
-                walk.cell[a] = if walk.step[a] > 0 {
-                    c.clamp(walk.cell[a], last[a])
-                } else {
-                    c.clamp(last[a], walk.cell[a])
-                };
-            }
-        }
-        walk.refresh();
-        true
     }
 }
 
@@ -315,7 +239,6 @@ impl Grid {
 /// asked for ahead of time ([`Grid::walk`]).
 struct OccupiedCells<'a, const READ_BLOCKS: bool> {
     grid: &'a Grid,
-    ray: &'a Ray,
     /// `None` once the ray has left the grid.
     walk: Option<CellWalk>,
     /// The octant of the ray's direction ([`reach::octant`]).
@@ -375,7 +298,8 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
                 }
                 Err(reach) => {
                     stats.leap_macrocells();
-                    if !grid.skip_empty_macrocells(walk, self.ray, reach) {
+                    // Past the empty cube of `reach` macrocells ahead ([`reach`]).
+                    if !walk.leave_cube(reach.max(1) as f32, MACROCELL_SIDE) {
                         self.walk = None;
                         return None;
                     }
@@ -391,7 +315,9 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
                     // leaving a cube of one cell.
                     Lookup::EmptyCell { reach } if reach >= 2 => {
                         stats.leap_cells();
-                        if !grid.skip_empty_cells(walk, self.ray, reach) {
+                        // Past the empty cube of `reach` cells ahead
+                        // ([`super::cell_reach`]).
+                        if !walk.leave_cube(reach as f32, 1.0) {
                             self.walk = None;
                             return None;
                         }
