@@ -108,7 +108,6 @@ impl GridFrame {
         let mut walk = CellWalk {
             cell,
             step,
-            far_side: IVec3::select(step.cmpgt(IVec3::ZERO), IVec3::ONE, IVec3::ZERO),
             step_f: step.as_vec3().into(),
             face: Vec3A::ZERO,
             slope: slope.into(),
@@ -138,11 +137,9 @@ pub(crate) struct CellWalk {
     pub cell: IVec3,
     /// −1, 0 or +1 per axis.
     pub step: IVec3,
-    /// 1 on axes the ray moves up, else 0: the cell's far face is `cell + far_side`.
-    far_side: IVec3,
     /// `step` as floats.
     step_f: Vec3A,
-    /// The current cell's far face per axis, `cell + far_side`, as floats (whole numbers,
+    /// The current cell's far face per axis, `cell + up`, as floats (whole numbers,
     /// so exact): a step adds to it and the exit distances follow in one multiply-add,
     /// without an integer-to-float conversion in the chain from one step to the next.
     face: Vec3A,
@@ -161,7 +158,7 @@ pub(crate) struct CellWalk {
     cells_per_t: Vec3A,
     /// 1 on axes the ray moves along, else 0.
     moving: Vec3A,
-    /// 1 on axes the ray moves up, else 0 (`far_side` as floats).
+    /// 1 on axes the ray moves up, else 0: the cell's far face is `cell + up`.
     up: Vec3A,
     /// `resolution` as floats.
     resolution_f: Vec3A,
@@ -212,7 +209,7 @@ impl CellWalk {
     /// Recomputes where the ray leaves the current cell, on every axis.
     #[inline(always)]
     pub fn refresh(&mut self) {
-        self.face = (self.cell + self.far_side).as_vec3().into();
+        self.face = self.cell.as_vec3a() + self.up;
         self.t_next = self.slope * self.face + self.offset;
     }
 
