@@ -146,8 +146,8 @@ pub(crate) struct CellWalk {
     /// The ray crosses the plane of cell face `k` on axis `a` at `t = slope[a]·k + offset[a]`
     /// (∞ for an axis the ray is parallel to): face distances come from whole-number face
     /// coordinates, so no error accumulates.
-    pub(crate) slope: Vec3A,
-    pub(crate) offset: Vec3A,
+    slope: Vec3A,
+    offset: Vec3A,
     /// Ray parameter at which the ray leaves the current cell, per axis.
     t_next: Vec3A,
     /// Ray parameter at which the ray leaves the grid (or reaches `t_max`).
@@ -155,11 +155,11 @@ pub(crate) struct CellWalk {
     resolution: UVec3,
     /// Cells crossed per unit of `t` on each axis (0 for an axis the ray is parallel to):
     /// the cell coordinate at `t` is `(t − offset)·cells_per_t`.
-    pub(crate) cells_per_t: Vec3A,
+    cells_per_t: Vec3A,
     /// 1 on axes the ray moves along, else 0.
-    pub(crate) moving: Vec3A,
+    moving: Vec3A,
     /// 1 on axes the ray moves up, else 0: the cell's far face is `cell + up`.
-    pub(crate) up: Vec3A,
+    up: Vec3A,
     /// `resolution` as floats.
     resolution_f: Vec3A,
 }

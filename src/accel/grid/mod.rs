@@ -17,12 +17,10 @@ mod box_counts;
 mod build;
 mod cell_reach;
 mod cells;
-mod irregular;
 mod overlap;
 mod reach;
 mod traverse;
 
-pub use irregular::{IrregularGrid, IrregularParams, IrregularStats};
 pub use traverse::{TraversalCounts, TraversalStats};
 
 use glam::{UVec3, Vec3};
