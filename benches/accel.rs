@@ -10,7 +10,9 @@
 //! machine's speed touch all three alike. That is one run; the ratios are reported as the
 //! median and the range over 5 runs. Then the grid's own counters per ray, each query's
 //! time per ray with caches cold and warm ([`cold_and_warm`]), the grid's time split
-//! between its walk and its triangles ([`Grid::walk`]), and its speed-up on all threads.
+//! between its walk and its triangles ([`Grid::walk`]), the ratio to Embree over the rays
+//! that hit the mesh and over those that miss it, each part timed alone, and the grid's
+//! speed-up on all threads.
 //!
 //! Run with `cargo bench --bench accel` after `tools/setup-dev.sh`. Environment:
 //! `ACCEL_BENCH_MODELS` (comma-separated files of data/dragon, default the smallest, a
@@ -125,6 +127,27 @@ fn walk_split(grid: &Grid, rays: &[Ray], stops: &[f32], run: usize) -> (f64, f64
     }
     let per_ray = |t: Duration| t.as_secs_f64() * 1e9 / rays.len() as f64;
     (per_ray(total[0]), per_ray(total[1]))
+}
+
+/// The grid's counters per ray over `rays`, as a phrase.
+fn counters(grid: &Grid, rays: &[Ray]) -> String {
+    let mut counts = TraversalCounts::default();
+    let mut hits = 0usize;
+    for r in rays {
+        hits += usize::from(grid.intersect_counting(r, &mut counts).is_some());
+    }
+    let per_ray = |x: u64| x as f64 / rays.len() as f64;
+    format!(
+        "{:.1} cells stepped ({:.1} occupied macrocells entered, {:.1} leaps over empty macrocells, {:.1} over empty cubes of cells, {:.1} plain steps), {:.1} occupied cells visited, {:.1} triangle tests, {:.2} hits per ray",
+        per_ray(counts.cells),
+        per_ray(counts.macrocell_entries),
+        per_ray(counts.macrocell_leaps),
+        per_ray(counts.cell_leaps),
+        per_ray(counts.plain_steps),
+        per_ray(counts.occupied),
+        per_ray(counts.tests),
+        hits as f64 / rays.len() as f64
+    )
 }
 
 /// How many times in a row each ray is traced for the warm figure.
@@ -294,23 +317,29 @@ fn main() {
                     100.0 * walk / query,
                     query - walk
                 ));
-                let mut counts = TraversalCounts::default();
-                let mut hits = 0usize;
-                for r in rays {
-                    hits += usize::from(grid.intersect_counting(r, &mut counts).is_some());
+                notes.push(format!("{model}, {name} rays: {}", counters(&grid, rays)));
+                // Rays that hit the mesh and rays that miss it (by Embree's answer) cost
+                // the two structures very differently: each part timed on its own, grid
+                // against Embree, like the table.
+                let (hit, miss): (Vec<Ray>, Vec<Ray>) =
+                    rays.iter().partition(|r| embree.intersect(r).is_some());
+                for (part, subset) in [("hit", &hit), ("miss", &miss)] {
+                    if subset.is_empty() {
+                        continue;
+                    }
+                    let rates: Vec<Vec<f64>> = (0..runs)
+                        .map(|run| run_once(subset, &queries[..2], run))
+                        .collect();
+                    let (ratio, lo, hi) = summary(rates.iter().map(|r| r[0] / r[1]).collect());
+                    let (g, ..) = summary(rates.iter().map(|r| 1e3 / r[0]).collect());
+                    let (e, ..) = summary(rates.iter().map(|r| 1e3 / r[1]).collect());
+                    notes.push(format!(
+                        "{model}, {name} rays that {part} the mesh ({} of {}): grid/Embree {ratio:.2} ({lo:.2}–{hi:.2}), ns per ray grid {g:.0}, Embree {e:.0}; {}",
+                        subset.len(),
+                        rays.len(),
+                        counters(&grid, subset)
+                    ));
                 }
-                let per_ray = |x: u64| x as f64 / rays.len() as f64;
-                notes.push(format!(
-                    "{model}, {name} rays: {:.1} cells stepped ({:.1} occupied macrocells entered, {:.1} leaps over empty macrocells, {:.1} over empty cubes of cells, {:.1} plain steps), {:.1} occupied cells visited, {:.1} triangle tests, {:.2} hits per ray",
-                    per_ray(counts.cells),
-                    per_ray(counts.macrocell_entries),
-                    per_ray(counts.macrocell_leaps),
-                    per_ray(counts.cell_leaps),
-                    per_ray(counts.plain_steps),
-                    per_ray(counts.occupied),
-                    per_ray(counts.tests),
-                    hits as f64 / rays.len() as f64
-                ));
             }
         }
         // Scaling of the grid over all threads, best of 3.
