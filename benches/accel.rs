@@ -129,6 +129,14 @@ fn walk_split(grid: &Grid, rays: &[Ray], stops: &[f32], run: usize) -> (f64, f64
     (per_ray(total[0]), per_ray(total[1]))
 }
 
+/// The grid over `mesh`, with `density` cells per triangle or the density it chooses.
+fn build_grid(mesh: &Mesh, density: Option<f32>) -> Grid {
+    match density {
+        Some(d) => Grid::from_mesh_with_density(mesh.positions.clone(), &mesh.indices, d),
+        None => Grid::from_mesh(mesh.positions.clone(), &mesh.indices),
+    }
+}
+
 /// The grid's counters per ray over `rays`, as a phrase.
 fn counters(grid: &Grid, rays: &[Ray]) -> String {
     let mut counts = TraversalCounts::default();
@@ -197,10 +205,10 @@ fn main() {
     );
     let count: usize = env_or("ACCEL_BENCH_RAYS", 100_000);
     let runs: usize = env_or("ACCEL_BENCH_RUNS", 5);
-    let density: f32 = env_or(
-        "ACCEL_BENCH_DENSITY",
-        gridtrace::accel::grid::DEFAULT_DENSITY,
-    );
+    // Unset: the density the grid chooses for each mesh.
+    let density: Option<f32> = std::env::var("ACCEL_BENCH_DENSITY")
+        .ok()
+        .and_then(|v| v.parse().ok());
     println!(
         "{count} rays per set, {runs} runs, chunks of {CHUNK} rays, best of {REPEATS} per chunk; {} threads for the scaling figure\n",
         rayon::current_num_threads()
@@ -220,13 +228,7 @@ fn main() {
         let mut build_times = [vec![], vec![], vec![]];
         for _ in 0..5 {
             let builds: [&dyn Fn(); 3] = [
-                &|| {
-                    drop(Grid::from_mesh_with_density(
-                        mesh.positions.clone(),
-                        &mesh.indices,
-                        density,
-                    ))
-                },
+                &|| drop(build_grid(&mesh, density)),
                 &|| drop(Embree::build(&mesh)),
                 &|| drop(Obvhs::build(&mesh)),
             ];
@@ -235,7 +237,7 @@ fn main() {
             }
         }
         let [grid_build, embree_build, bvh_build] = build_times.map(|t| summary(t).0);
-        let grid = Grid::from_mesh_with_density(mesh.positions.clone(), &mesh.indices, density);
+        let grid = build_grid(&mesh, density);
         let embree = Embree::build(&mesh);
         let bvh = Obvhs::build(&mesh);
         let stats = grid.stats();

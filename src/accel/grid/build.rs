@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use super::block::{Block, LANES};
 use super::cells::{CellIndex, MACRO_CELLS};
 use super::overlap::{Polygon, TriangleBoxTest};
-use super::{DEFAULT_DENSITY, Grid};
+use super::{Grid, density};
 use crate::accel::frame::{GridFrame, padded, resolution};
 use crate::accel::{Triangle, huge_pages};
 use crate::scene::Aabb;
@@ -19,30 +19,33 @@ pub(super) const SINGLE_CELL_MAX: usize = 2 * LANES;
 const SMALL_BOX_CELLS: u64 = 64;
 
 impl Grid {
-    /// Builds a grid over a triangle soup with the default density.
+    /// Builds a grid over a triangle soup, with the density chosen for it ([`density`]).
     pub fn build(triangles: Vec<Triangle>) -> Grid {
-        Grid::build_with_density(triangles, DEFAULT_DENSITY)
+        let (vertices, indices) = soup(&triangles);
+        Grid::build_mesh(vertices, &indices, None)
     }
 
     /// Builds a grid over a triangle soup with about `density` cells per triangle.
     pub fn build_with_density(triangles: Vec<Triangle>, density: f32) -> Grid {
-        let vertices: Vec<Vec3> = triangles.iter().flat_map(|t| t.vertices()).collect();
-        let indices: Vec<[u32; 3]> = (0..triangles.len() as u32)
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect();
-        Grid::from_mesh_with_density(vertices, &indices, density)
+        let (vertices, indices) = soup(&triangles);
+        Grid::build_mesh(vertices, &indices, Some(density))
     }
 
-    /// Builds a grid over an indexed mesh with the default density.
-    pub fn from_mesh(vertices: Vec<Vec3>, indices: &[[u32; 3]]) -> Grid {
-        Grid::from_mesh_with_density(vertices, indices, DEFAULT_DENSITY)
-    }
-
-    /// Builds a grid over an indexed mesh with about `density` cells per triangle.
+    /// Builds a grid over an indexed mesh, with the density chosen for it ([`density`]).
     ///
     /// Degenerate triangles (no area, non-finite corners, or corners past the vertex array)
     /// go into no cell and so are never hit; hits report indices into `indices`.
+    pub fn from_mesh(vertices: Vec<Vec3>, indices: &[[u32; 3]]) -> Grid {
+        Grid::build_mesh(vertices, indices, None)
+    }
+
+    /// Builds a grid over an indexed mesh with about `density` cells per triangle.
     pub fn from_mesh_with_density(vertices: Vec<Vec3>, indices: &[[u32; 3]], density: f32) -> Grid {
+        Grid::build_mesh(vertices, indices, Some(density))
+    }
+
+    /// [`Grid::from_mesh_with_density`], the density chosen for the mesh when `None`.
+    fn build_mesh(vertices: Vec<Vec3>, indices: &[[u32; 3]], density: Option<f32>) -> Grid {
         let triangle = |t: &[u32; 3]| {
             t.iter()
                 .all(|&i| (i as usize) < vertices.len())
@@ -102,6 +105,8 @@ impl Grid {
             let wanted = if live.len() <= SINGLE_CELL_MAX {
                 UVec3::ONE
             } else {
+                let density =
+                    density.unwrap_or_else(|| density::density_for(bounds, &triangles, &live));
                 resolution(bounds.extent(), live.len(), density)
             };
             (
@@ -276,6 +281,15 @@ impl Grid {
             f(self.storage_key(c));
         }
     }
+}
+
+/// The vertices and indices of a triangle soup, three corners per triangle.
+fn soup(triangles: &[Triangle]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let vertices = triangles.iter().flat_map(|t| t.vertices()).collect();
+    let indices = (0..triangles.len() as u32)
+        .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .collect();
+    (vertices, indices)
 }
 
 /// Most references (cell, triangle pairs) the build may make per triangle on average, and in

@@ -17,6 +17,7 @@ mod box_counts;
 mod build;
 mod cell_reach;
 mod cells;
+pub mod density;
 mod overlap;
 mod reach;
 mod traverse;
@@ -30,9 +31,6 @@ use cells::{CellIndex, Lookup};
 
 use super::frame::GridFrame;
 use crate::scene::Aabb;
-
-/// Cells per triangle aimed for by the resolution heuristic (λ in Cleary & Wyvill 1988).
-pub const DEFAULT_DENSITY: f32 = 5.0;
 
 /// A uniform grid accelerating ray queries against one triangle list.
 #[derive(Clone, Debug)]
