@@ -20,8 +20,8 @@ use crate::accel::Triangle;
 use crate::accel::frame::{GridFrame, resolution};
 use crate::scene::Aabb;
 
-/// λ for evenly spread triangles (the Stanford dragons of 11k and 203k triangles: 1.02–1.12×
-/// the speed of λ = 5 on outside and bounce rays, 25–35 % less memory; README, "How it
+/// λ for evenly spread triangles (the Stanford dragons of 11k and 203k triangles: 1.02–1.10×
+/// the speed of λ = 5 on outside and bounce rays, 28–32 % less memory; README, "How it
 /// works").
 pub const EVEN_DENSITY: f32 = 2.0;
 
