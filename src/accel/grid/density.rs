@@ -126,10 +126,10 @@ mod tests {
     /// a hundred times its size (two triangles) gets the fine one.
     #[test]
     fn crowded_meshes_get_finer_cells() {
-        let ball = cube_surface(60);
-        let b = bounds(&ball);
-        assert_eq!(density_for(b, &ball, &live(&ball)), EVEN_DENSITY);
-        let mut on_floor = ball.clone();
+        let surface = cube_surface(60);
+        let b = bounds(&surface);
+        assert_eq!(density_for(b, &surface, &live(&surface)), EVEN_DENSITY);
+        let mut on_floor = surface.clone();
         let corner = |x: f32, z: f32| Vec3::new(x, -1.0, z);
         on_floor.push(Some(Triangle::new(
             corner(-100.0, -100.0),
@@ -147,7 +147,8 @@ mod tests {
         assert_eq!(density_for(b, &on_floor, &live(&on_floor)), UNEVEN_DENSITY);
     }
 
-    /// Between the two, the density grows with the crowding, continuously.
+    /// Between the two, the density never falls as the floor grows, and ends above the
+    /// coarse one.
     #[test]
     fn the_density_grows_with_the_crowding() {
         let mut previous = 0.0;
