@@ -74,54 +74,77 @@ impl GridFrame {
     }
 
     /// Clips the ray to the box and finds the first cell; `None` when it misses the box.
-    /// Inlined, so that it is compiled with the caller's instruction set (otherwise
-    /// `floor` is a call into libm).
+    /// In vector lanes, with no `f32::min`/`max` (whose NaN handling costs more than the
+    /// rest): lanes that could be NaN are chosen away first. Inlined, so that it is
+    /// compiled with the caller's instruction set.
     #[inline(always)]
     pub fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
-        if !(ray.origin.is_finite() && ray.direction.is_finite()) {
+        let origin = Vec3A::from(ray.origin);
+        let direction = Vec3A::from(ray.direction);
+        if !(origin.is_finite() && direction.is_finite()) {
             return None;
         }
-        let inv = ray.direction.recip();
-        let t0 = (self.bounds.min - ray.origin) * inv;
-        let t1 = (self.bounds.max - ray.origin) * inv;
-        // f32::max/min skip NaN (0·∞ for an origin on a slab of a parallel axis).
-        let near = t0.min(t1);
+        let inv = direction.recip();
+        // An axis the ray is parallel to (or so nearly that 1/d overflows) does not move:
+        // slope 0 and offset ∞ put its faces at ∞, and its slab holds the whole ray or none
+        // of it (0·∞ would be NaN for an origin on one of its planes).
+        let moving = inv.abs().cmplt(Vec3A::INFINITY);
+        let (lo, hi) = (Vec3A::from(self.bounds.min), Vec3A::from(self.bounds.max));
+        let t0 = (lo - origin) * inv;
+        let t1 = (hi - origin) * inv;
+        let inside = origin.cmpgt(lo) & origin.cmplt(hi);
+        let (all, none) = (Vec3A::NEG_INFINITY, Vec3A::INFINITY);
+        let near = Vec3A::select(moving, t0.min(t1), Vec3A::select(inside, all, none));
         // Widen each slab's exit by its rounding error, so a ray through the box is never
         // clipped away by rounding (pbrt-v4 §6.8.2: t_far·(1 + 2γ(3))).
-        let far = t0.max(t1) * (1.0 + 2.0 * super::SLAB_ROUNDING);
-        let t_start = ray.t_min.max(near.x).max(near.y).max(near.z);
-        let t_end = ray.t_max.min(far.x).min(far.y).min(far.z);
+        let far = Vec3A::select(
+            moving,
+            t0.max(t1) * (1.0 + 2.0 * super::SLAB_ROUNDING),
+            Vec3A::select(inside, none, all),
+        );
+        let t_start = near.max_element().max(ray.t_min);
+        let t_end = far.min_element().min(ray.t_max);
         // Written so that a NaN bound also counts as a miss.
         if t_start > t_end || t_start.is_nan() || t_end.is_nan() {
             return None;
         }
-        let cell = self.cell_of(ray.at(t_start)).as_ivec3();
-        let step = IVec3::new(
-            step_of(ray.direction.x),
-            step_of(ray.direction.y),
-            step_of(ray.direction.z),
+        let resolution_f = self.resolution.as_vec3a();
+        let at = origin + direction * t_start;
+        let cell_f = truncate(
+            ((at - lo) * Vec3A::from(self.inv_cell_size))
+                .max(Vec3A::ZERO)
+                .min(resolution_f - Vec3A::ONE),
         );
-        // An axis the ray is parallel to gets slope 0 and offset ∞: its faces lie at ∞.
-        let moving = step.cmpne(IVec3::ZERO);
-        let slope = Vec3::select(moving, self.cell_size * inv, Vec3::ZERO);
-        let offset = Vec3::select(moving, t0, Vec3::INFINITY);
+        let up = moving & direction.cmpgt(Vec3A::ZERO);
+        let step_f = Vec3A::select(
+            up,
+            Vec3A::ONE,
+            Vec3A::select(moving, Vec3A::NEG_ONE, Vec3A::ZERO),
+        );
+        let cells_per_t = Vec3A::select(
+            moving,
+            direction * Vec3A::from(self.inv_cell_size),
+            Vec3A::ZERO,
+        );
+        let slope = Vec3A::select(moving, Vec3A::from(self.cell_size) * inv, Vec3A::ZERO);
+        let offset = Vec3A::select(moving, t0, Vec3A::INFINITY);
         let mut walk = CellWalk {
-            cell,
-            step,
-            step_f: step.as_vec3().into(),
+            cell: whole_cells(cell_f),
+            step: whole_cells(step_f),
+            step_f,
             face: Vec3A::ZERO,
-            slope: slope.into(),
-            offset: offset.into(),
+            slope,
+            offset,
             t_next: Vec3A::INFINITY,
             t_end,
             resolution: self.resolution,
-            cells_per_t: Vec3::select(moving, ray.direction * self.inv_cell_size, Vec3::ZERO)
-                .into(),
-            moving: Vec3::select(moving, Vec3::ONE, Vec3::ZERO).into(),
-            up: Vec3::select(step.cmpgt(IVec3::ZERO), Vec3::ONE, Vec3::ZERO).into(),
-            resolution_f: self.resolution.as_vec3().into(),
+            cells_per_t,
+            cells_at_zero: Vec3A::select(moving, -offset * cells_per_t, cell_f + Vec3A::splat(0.5)),
+            up: Vec3A::select(up, Vec3A::ONE, Vec3A::ZERO),
+            resolution_f,
         };
-        walk.refresh();
+        walk.face = cell_f + walk.up;
+        walk.t_next = walk.slope * walk.face + walk.offset;
         Some(walk)
     }
 }
@@ -156,8 +179,9 @@ pub(crate) struct CellWalk {
     /// Cells crossed per unit of `t` on each axis (0 for an axis the ray is parallel to):
     /// the cell coordinate at `t` is `(t − offset)·cells_per_t`.
     cells_per_t: Vec3A,
-    /// 1 on axes the ray moves along, else 0.
-    moving: Vec3A,
+    /// The cell coordinate at `t = 0`, `−offset·cells_per_t`, so the coordinate at `t` is
+    /// one multiply-add; on an axis the ray is parallel to, the middle of its cells' slab.
+    cells_at_zero: Vec3A,
     /// 1 on axes the ray moves up, else 0: the cell's far face is `cell + up`.
     up: Vec3A,
     /// `resolution` as floats.
@@ -176,41 +200,42 @@ impl CellWalk {
     #[inline(always)]
     pub fn leave_cube(&mut self, side: f32, unit: f32) -> bool {
         let cell = self.face - self.up;
-        let base = (cell * (1.0 / unit)).floor() * unit;
+        // (For cubes of cells, the cell is its own unit: no rounding in the chain.)
+        let base = if unit == 1.0 {
+            cell
+        } else {
+            truncate(cell * (1.0 / unit)) * unit
+        };
         // The cube's far faces: past `base` by `side` units upwards, or `side − 1` below
-        // `base` downwards; within the grid.
-        let far_up = (base + Vec3A::splat(side * unit)).min(self.resolution_f);
-        let far_down = (base - Vec3A::splat((side - 1.0) * unit)).max(Vec3A::ZERO);
-        let up = self.up.cmpne(Vec3A::ZERO);
-        let far = Vec3A::select(up, far_up, far_down);
+        // `base` downwards (`base + unit − side·unit`); within the grid.
+        let down_unit = (Vec3A::ONE - self.up) * unit;
+        let far = (self.step_f * Vec3A::splat(side * unit) + (base + down_unit))
+            .clamp(Vec3A::ZERO, self.resolution_f);
         let t = self.slope * far + self.offset;
         let on_x = (t.x <= t.y) & (t.x <= t.z);
         let on_y = !on_x & (t.y <= t.z);
         let on_z = !on_x & !on_y;
-        let t_exit = t.x.min(t.y).min(t.z);
+        let t_exit = least(t);
         let chosen = glam::BVec3A::new(on_x, on_y, on_z);
-        // The cube's last cells, and the cell beyond on the exit axis.
-        let last = Vec3A::select(up, far - Vec3A::ONE, far);
-        let next = last + self.step_f;
+        // The cube's last cells (`far − 1` upwards, `far` downwards), and the cell beyond
+        // on the exit axis (`far` upwards, `far − 1` downwards).
+        let last = far - self.up;
+        let next = far + self.up - Vec3A::ONE;
         let beyond = next.cmplt(Vec3A::ZERO) | next.cmpge(self.resolution_f);
         if (t_exit >= self.t_end) | (beyond & chosen).any() {
             return false;
         }
-        let under = ((Vec3A::splat(t_exit) - self.offset) * self.cells_per_t).floor();
+        // The cell under the exit point on the other axes (on an axis the ray is parallel
+        // to, its own cell: `cells_at_zero` holds it there and `cells_per_t` is 0).
+        // (Truncated, not rounded down: a coordinate within rounding below 0 becomes 0
+        // instead of −1, and the clamp below raises it to 0 or more either way.)
+        let under = truncate(self.cells_per_t * Vec3A::splat(t_exit) + self.cells_at_zero);
         let side_cell = under.clamp(cell.min(last), cell.max(last));
-        let moving = self.moving.cmpne(Vec3A::ZERO);
-        let landed = Vec3A::select(chosen, next, Vec3A::select(moving, side_cell, cell));
-        self.cell = landed.as_ivec3();
+        let landed = Vec3A::select(chosen, next, side_cell);
+        self.cell = whole_cells(landed);
         self.face = landed + self.up;
         self.t_next = self.slope * self.face + self.offset;
         true
-    }
-
-    /// Recomputes where the ray leaves the current cell, on every axis.
-    #[inline(always)]
-    pub fn refresh(&mut self) {
-        self.face = self.cell.as_vec3a() + self.up;
-        self.t_next = self.slope * self.face + self.offset;
     }
 
     /// Leaves the current cell: returns the largest ray parameter whose hits belong to it
@@ -223,7 +248,7 @@ impl CellWalk {
         let on_x = (t.x <= t.y) & (t.x <= t.z);
         let on_y = !on_x & (t.y <= t.z);
         let on_z = !on_x & !on_y;
-        let t_exit = t.x.min(t.y).min(t.z);
+        let t_exit = least(t);
         let chosen = IVec3::new(i32::from(on_x), i32::from(on_y), i32::from(on_z));
         let next = self.cell + chosen * self.step;
         // Outside on some axis (a negative coordinate wraps to a huge unsigned one), or a
@@ -244,15 +269,42 @@ impl CellWalk {
     }
 }
 
-#[inline]
-fn step_of(d: f32) -> i32 {
-    if d > 0.0 {
-        1
-    } else if d < 0.0 {
-        -1
-    } else {
-        0
+/// The least of `v`'s three lanes, none of them NaN (an axis the ray is parallel to has
+/// its faces at ∞), without `f32::min`'s handling of NaN.
+#[inline(always)]
+fn least(v: Vec3A) -> f32 {
+    let min = |a: f32, b: f32| if a < b { a } else { b };
+    min(min(v.x, v.y), v.z)
+}
+
+/// `v` rounded towards zero (as whole-number floats): `floor` for the non-negative
+/// coordinates of a walk, in two instructions where glam's `floor` takes nine.
+#[inline(always)]
+fn truncate(v: Vec3A) -> Vec3A {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{__m128, _mm_cvtepi32_ps, _mm_cvttps_epi32};
+        // SAFETY: SSE2, which these intrinsics need, is part of x86_64.
+        Vec3A::from(unsafe { _mm_cvtepi32_ps(_mm_cvttps_epi32(__m128::from(v))) })
     }
+    #[cfg(not(target_arch = "x86_64"))]
+    v.trunc()
+}
+
+/// Cell coordinates held as whole-number floats (in the grid, so in range), converted by
+/// truncation in one instruction: `as` would check each lane for overflow and NaN.
+#[inline(always)]
+fn whole_cells(v: Vec3A) -> IVec3 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{__m128, __m128i, _mm_cvttps_epi32};
+        // SAFETY: SSE2, which this intrinsic needs, is part of x86_64.
+        let lanes: [i32; 4] =
+            unsafe { std::mem::transmute::<__m128i, [i32; 4]>(_mm_cvttps_epi32(__m128::from(v))) };
+        IVec3::new(lanes[0], lanes[1], lanes[2])
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    v.as_ivec3()
 }
 
 /// The box grown by a small fraction of its size, so flat contents get a volume and nothing
