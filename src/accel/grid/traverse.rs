@@ -92,6 +92,20 @@ impl TraversalStats for TraversalCounts {
     }
 }
 
+/// True when the processor has what the queries' versions compiled for AVX2 use: AVX2 for
+/// a block's eight lanes, POPCNT for an occupied cell's rank (without it, `count_ones` is
+/// a seventeen-instruction bit trick on every step into an occupied cell), BMI1 and BMI2
+/// for bit tests and shifts. Every x86-64 processor with AVX2 has the other three; the
+/// check is cached by the standard library.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn x86_fast_path() -> bool {
+    std::is_x86_feature_detected!("avx2")
+        && std::is_x86_feature_detected!("popcnt")
+        && std::is_x86_feature_detected!("bmi1")
+        && std::is_x86_feature_detected!("bmi2")
+}
+
 impl Grid {
     /// The closest hit along `ray`, if any.
     pub fn intersect(&self, ray: &Ray) -> Option<GridHit> {
@@ -105,8 +119,8 @@ impl Grid {
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
         #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor has AVX2, checked just above.
+        if x86_fast_path() {
+            // SAFETY: the processor has the features enabled there, checked just above.
             return unsafe { self.intersect_avx2(ray, stats) };
         }
         self.intersect_portable(ray, stats)
@@ -115,7 +129,7 @@ impl Grid {
     /// [`Grid::intersect_portable`] compiled for AVX2, where a block's eight lanes are one
     /// vector (the arithmetic, and so the answer, is the same).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
     fn intersect_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
         self.intersect_portable(ray, stats)
     }
@@ -149,8 +163,8 @@ impl Grid {
     /// triangles.
     pub fn walk(&self, ray: &Ray, t_stop: f32) -> usize {
         #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor has AVX2, checked just above.
+        if x86_fast_path() {
+            // SAFETY: the processor has the features enabled there, checked just above.
             return unsafe { self.walk_avx2(ray, t_stop) };
         }
         self.walk_portable(ray, t_stop)
@@ -158,7 +172,7 @@ impl Grid {
 
     /// [`Grid::walk_portable`] compiled for AVX2, like the queries.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
     fn walk_avx2(&self, ray: &Ray, t_stop: f32) -> usize {
         self.walk_portable(ray, t_stop)
     }
@@ -184,8 +198,8 @@ impl Grid {
     /// [`Grid::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor has AVX2, checked just above.
+        if x86_fast_path() {
+            // SAFETY: the processor has the features enabled there, checked just above.
             return unsafe { self.occluded_avx2(ray, stats) };
         }
         self.occluded_portable(ray, stats)
@@ -193,7 +207,7 @@ impl Grid {
 
     /// [`Grid::occluded_portable`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
     fn occluded_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         self.occluded_portable(ray, stats)
     }
