@@ -2,7 +2,7 @@
 //! near-cubic cells, the cell under a point, and the 3D-DDA walk of Amanatides & Woo (1987),
 //! "A fast voxel traversal algorithm for ray tracing", through the cells a ray crosses.
 
-use glam::{IVec3, UVec3, Vec3, Vec3A};
+use glam::{BVec3A, IVec3, UVec3, Vec3, Vec3A, Vec3Swizzles};
 
 use super::Ray;
 use crate::scene::Aabb;
@@ -11,6 +11,11 @@ use crate::scene::Aabb;
 pub(crate) const MAX_RESOLUTION: u32 = 2048;
 /// Most cells in one grid (per-cell build counters would otherwise be absurd).
 pub(crate) const MAX_CELLS: u64 = 1 << 28;
+
+/// The largest `1/d` of an axis a walk moves along: a smaller `|d|` counts as parallel
+/// (over any practical ray length it moves far less than rounding), so that no face
+/// distance `slope·k + offset` can overflow to ∞ − ∞ = NaN.
+const MOVING_INVERSE: f32 = 1e30;
 
 /// A box tiled by `resolution` equal cells, numbered x fastest, then y, then z.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,10 +90,10 @@ impl GridFrame {
             return None;
         }
         let inv = direction.recip();
-        // An axis the ray is parallel to (or so nearly that 1/d overflows) does not move:
+        // An axis the ray is parallel to (or so nearly that 1/d nears overflow) does not move:
         // slope 0 and offset ∞ put its faces at ∞, and its slab holds the whole ray or none
         // of it (0·∞ would be NaN for an origin on one of its planes).
-        let moving = inv.abs().cmplt(Vec3A::INFINITY);
+        let moving = inv.abs().cmplt(Vec3A::splat(MOVING_INVERSE));
         let (lo, hi) = (Vec3A::from(self.bounds.min), Vec3A::from(self.bounds.max));
         let t0 = (lo - origin) * inv;
         let t1 = (hi - origin) * inv;
@@ -137,7 +142,6 @@ impl GridFrame {
             offset,
             t_next: Vec3A::INFINITY,
             t_end,
-            resolution: self.resolution,
             cells_per_t,
             cells_at_zero: Vec3A::select(moving, -offset * cells_per_t, cell_f + Vec3A::splat(0.5)),
             up: Vec3A::select(up, Vec3A::ONE, Vec3A::ZERO),
@@ -175,7 +179,6 @@ pub(crate) struct CellWalk {
     t_next: Vec3A,
     /// Ray parameter at which the ray leaves the grid (or reaches `t_max`).
     pub t_end: f32,
-    resolution: UVec3,
     /// Cells crossed per unit of `t` on each axis (0 for an axis the ray is parallel to):
     /// the cell coordinate at `t` is `(t − offset)·cells_per_t`.
     cells_per_t: Vec3A,
@@ -211,12 +214,7 @@ impl CellWalk {
         let down_unit = (Vec3A::ONE - self.up) * unit;
         let far = (self.step_f * Vec3A::splat(side * unit) + (base + down_unit))
             .clamp(Vec3A::ZERO, self.resolution_f);
-        let t = self.slope * far + self.offset;
-        let on_x = (t.x <= t.y) & (t.x <= t.z);
-        let on_y = !on_x & (t.y <= t.z);
-        let on_z = !on_x & !on_y;
-        let t_exit = least(t);
-        let chosen = glam::BVec3A::new(on_x, on_y, on_z);
+        let (t_exit, chosen) = first_exit(self.slope * far + self.offset);
         // The cube's last cells (`far − 1` upwards, `far` downwards), and the cell beyond
         // on the exit axis (`far` upwards, `far − 1` downwards).
         let last = far - self.up;
@@ -243,30 +241,40 @@ impl CellWalk {
     /// when there is none (the ray leaves the grid or reaches its end here).
     #[inline(always)]
     pub fn advance(&mut self) -> (f32, bool) {
-        let t = self.t_next;
-        // The axis whose face comes first (x before y before z on ties), as 0/1 masks.
-        let on_x = (t.x <= t.y) & (t.x <= t.z);
-        let on_y = !on_x & (t.y <= t.z);
-        let on_z = !on_x & !on_y;
-        let t_exit = least(t);
-        let chosen = IVec3::new(i32::from(on_x), i32::from(on_y), i32::from(on_z));
-        let next = self.cell + chosen * self.step;
-        // Outside on some axis (a negative coordinate wraps to a huge unsigned one), or a
-        // face at or past the end: this cell was the last.
-        let outside = next.as_uvec3().cmpge(self.resolution).any();
-        if outside | (t_exit >= self.t_end) {
+        let (t_exit, axis) = first_exit(self.t_next);
+        // One cell on along the exit axis.
+        let moved = Vec3A::select(axis, self.step_f, Vec3A::ZERO);
+        let next = self.face - self.up + moved;
+        // Outside on that axis, or a face at or past the end: this cell was the last.
+        let outside = next.cmplt(Vec3A::ZERO) | next.cmpge(self.resolution_f);
+        if outside.any() | (t_exit >= self.t_end) {
             return (self.t_end, false);
         }
-        self.cell = next;
-        let chosen_f = Vec3A::select(
-            glam::BVec3A::new(on_x, on_y, on_z),
-            self.step_f,
-            Vec3A::ZERO,
-        );
-        self.face += chosen_f;
+        self.cell = whole_cells(next);
+        self.face += moved;
         self.t_next = self.slope * self.face + self.offset;
         (t_exit, true)
     }
+}
+
+/// Where a ray first reaches one of the faces it crosses at `t` (per axis), and on which
+/// axis, as a lane mask (x before y before z on ties, so a walk never moves on two axes at
+/// once). The mask comes from comparing the lanes with their rotations, in parallel with
+/// the least distance rather than after it (the walk's steps are one chain of dependent
+/// operations, so its length is what a step costs).
+#[inline(always)]
+fn first_exit(t: Vec3A) -> (f32, BVec3A) {
+    let (next, after) = (t.yzx(), t.zxy());
+    // Per lane: at or before the next lane, strictly before it, at or before the lane
+    // after, strictly before it — x wins if t.x ≤ t.y and t.x ≤ t.z, y if t.y ≤ t.z and
+    // t.y < t.x, z if t.z < t.x and t.z < t.y.
+    let (le_next, lt_next) = (t.cmple(next), t.cmplt(next));
+    let (le_after, lt_after) = (t.cmple(after), t.cmplt(after));
+    let x = BVec3A::new(true, false, false);
+    let y = BVec3A::new(false, true, false);
+    let first =
+        (x & le_next & le_after) | (y & le_next & lt_after) | (!(x | y) & lt_next & lt_after);
+    (least(t), first)
 }
 
 /// The least of `v`'s three lanes, none of them NaN (an axis the ray is parallel to has
