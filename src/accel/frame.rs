@@ -2,8 +2,6 @@
 //! near-cubic cells, the cell under a point, and the 3D-DDA walk of Amanatides & Woo (1987),
 //! "A fast voxel traversal algorithm for ray tracing", through the cells a ray crosses.
 
-use std::marker::PhantomData;
-
 use glam::{BVec3A, IVec3, UVec3, Vec3, Vec3A, Vec3Swizzles};
 
 use super::Ray;
@@ -13,45 +11,6 @@ use crate::scene::Aabb;
 pub(crate) const MAX_RESOLUTION: u32 = 2048;
 /// Most cells in one grid (per-cell build counters would otherwise be absurd).
 pub(crate) const MAX_CELLS: u64 = 1 << 28;
-
-/// How a walk computes its multiply-adds `a·b + c`: [`Fused`] (one rounding, one
-/// instruction — only in code compiled for FMA, where `mul_add` is that instruction;
-/// elsewhere it is a call into libm) or [`Unfused`] (a product and a sum). A walk uses one
-/// throughout, so its face distances agree with each other; each multiply-add is a link in
-/// the chain of dependent operations that a step is, so fusing them shortens the step.
-pub(crate) trait MulAdd: Copy {
-    fn mul_add(a: Vec3A, b: Vec3A, c: Vec3A) -> Vec3A;
-}
-
-/// Multiply-adds fused: for code compiled with FMA enabled.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Fused;
-
-/// Multiply-adds as a product and a sum.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Unfused;
-
-impl MulAdd for Fused {
-    #[inline(always)]
-    fn mul_add(a: Vec3A, b: Vec3A, c: Vec3A) -> Vec3A {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{__m128, _mm_fmadd_ps};
-            // SAFETY: `Fused` is used only in code compiled with FMA enabled, on processors
-            // checked to have it.
-            Vec3A::from(unsafe { _mm_fmadd_ps(__m128::from(a), __m128::from(b), __m128::from(c)) })
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        a.mul_add(b, c)
-    }
-}
-
-impl MulAdd for Unfused {
-    #[inline(always)]
-    fn mul_add(a: Vec3A, b: Vec3A, c: Vec3A) -> Vec3A {
-        a * b + c
-    }
-}
 
 /// The largest `1/d` of an axis a walk moves along: a smaller `|d|` counts as parallel
 /// (over any practical ray length it moves far less than rounding), so that no face
@@ -124,7 +83,7 @@ impl GridFrame {
     /// rest): lanes that could be NaN are chosen away first. Inlined, so that it is
     /// compiled with the caller's instruction set.
     #[inline(always)]
-    pub fn start_walk<M: MulAdd>(&self, ray: &Ray) -> Option<CellWalk<M>> {
+    pub fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
         let origin = Vec3A::from(ray.origin);
         let direction = Vec3A::from(ray.direction);
         if !(origin.is_finite() && direction.is_finite()) {
@@ -187,10 +146,9 @@ impl GridFrame {
             cells_at_zero: Vec3A::select(moving, -offset * cells_per_t, cell_f + Vec3A::splat(0.5)),
             up: Vec3A::select(up, Vec3A::ONE, Vec3A::ZERO),
             resolution_f,
-            mul_add: PhantomData,
         };
         walk.face = cell_f + walk.up;
-        walk.t_next = M::mul_add(walk.slope, walk.face, walk.offset);
+        walk.t_next = walk.slope * walk.face + walk.offset;
         Some(walk)
     }
 }
@@ -201,7 +159,7 @@ impl GridFrame {
 /// bounce rays, so a branch on it would be mispredicted about every other step) and
 /// without indexing vectors by a run-time axis, so the state stays in registers.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct CellWalk<M> {
+pub(crate) struct CellWalk {
     /// Current cell.
     pub cell: IVec3,
     /// −1, 0 or +1 per axis.
@@ -231,11 +189,9 @@ pub(crate) struct CellWalk<M> {
     up: Vec3A,
     /// `resolution` as floats.
     resolution_f: Vec3A,
-    /// How its multiply-adds are computed.
-    mul_add: PhantomData<M>,
 }
 
-impl<M: MulAdd> CellWalk<M> {
+impl CellWalk {
     /// Moves the walk out of the empty cube of `side` units of `unit` cells a side (units
     /// aligned to multiples of `unit`) that has the current cell's unit as its corner and
     /// extends in the ray's direction, to the first cell beyond it along the ray; false
@@ -256,9 +212,9 @@ impl<M: MulAdd> CellWalk<M> {
         // The cube's far faces: past `base` by `side` units upwards, or `side − 1` below
         // `base` downwards (`base + unit − side·unit`); within the grid.
         let down_unit = (Vec3A::ONE - self.up) * unit;
-        let far = M::mul_add(self.step_f, Vec3A::splat(side * unit), base + down_unit)
+        let far = (self.step_f * Vec3A::splat(side * unit) + (base + down_unit))
             .clamp(Vec3A::ZERO, self.resolution_f);
-        let (t_exit, chosen) = first_exit(M::mul_add(self.slope, far, self.offset));
+        let (t_exit, chosen) = first_exit(self.slope * far + self.offset);
         // The cube's last cells (`far − 1` upwards, `far` downwards), and the cell beyond
         // on the exit axis (`far` upwards, `far − 1` downwards).
         let last = far - self.up;
@@ -271,16 +227,12 @@ impl<M: MulAdd> CellWalk<M> {
         // to, its own cell: `cells_at_zero` holds it there and `cells_per_t` is 0).
         // (Truncated, not rounded down: a coordinate within rounding below 0 becomes 0
         // instead of −1, and the clamp below raises it to 0 or more either way.)
-        let under = truncate(M::mul_add(
-            self.cells_per_t,
-            Vec3A::splat(t_exit),
-            self.cells_at_zero,
-        ));
+        let under = truncate(self.cells_per_t * Vec3A::splat(t_exit) + self.cells_at_zero);
         let side_cell = under.clamp(cell.min(last), cell.max(last));
         let landed = Vec3A::select(chosen, next, side_cell);
         self.cell = whole_cells(landed);
         self.face = landed + self.up;
-        self.t_next = M::mul_add(self.slope, self.face, self.offset);
+        self.t_next = self.slope * self.face + self.offset;
         true
     }
 
@@ -300,7 +252,7 @@ impl<M: MulAdd> CellWalk<M> {
         }
         self.cell = whole_cells(next);
         self.face += moved;
-        self.t_next = M::mul_add(self.slope, self.face, self.offset);
+        self.t_next = self.slope * self.face + self.offset;
         (t_exit, true)
     }
 }
@@ -430,7 +382,7 @@ mod tests {
             UVec3::splat(4),
         );
         let ray = Ray::new(Vec3::new(-1.0, 0.5, 0.5), Vec3::new(1.0, 0.0, 0.0));
-        let mut walk = frame.start_walk::<Unfused>(&ray).unwrap();
+        let mut walk = frame.start_walk(&ray).unwrap();
         let mut cells = vec![walk.cell];
         loop {
             let x = walk.cell.x;
@@ -473,7 +425,7 @@ mod tests {
                 direction[k / 10 % 3] = 0.0;
             }
             let ray = Ray::new(origin, direction.normalize());
-            let Some(start) = frame.start_walk::<Unfused>(&ray) else {
+            let Some(start) = frame.start_walk(&ray) else {
                 continue;
             };
             let unit = if k % 2 == 0 { 1 } else { 8 };

@@ -9,7 +9,7 @@
 use glam::UVec3;
 
 use super::Ray;
-use super::frame::{GridFrame, Unfused, padded, resolution};
+use super::frame::{GridFrame, padded, resolution};
 use crate::scene::Aabb;
 
 /// Cells per instance aimed for (λ of Cleary & Wyvill 1988). Instances are larger than
@@ -99,7 +99,7 @@ impl InstanceGrid {
     /// Calls `visit` with the instances of each non-empty cell along the ray, front to back,
     /// and the largest ray parameter that belongs to the cell, until it returns true.
     pub fn walk(&self, ray: &Ray, mut visit: impl FnMut(&[u32], f32) -> bool) {
-        let Some(mut walk) = self.frame.start_walk::<Unfused>(ray) else {
+        let Some(mut walk) = self.frame.start_walk(ray) else {
             return;
         };
         loop {

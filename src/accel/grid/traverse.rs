@@ -14,7 +14,7 @@ use super::cells::{Lookup, MACRO_SHIFT};
 use super::reach;
 use super::{Grid, GridHit};
 use crate::accel::Ray;
-use crate::accel::frame::{CellWalk, Fused, MulAdd, Unfused};
+use crate::accel::frame::CellWalk;
 use crate::accel::prefetch::prefetch;
 
 /// Cells along a macrocell's edge, as the unit of [`CellWalk::leave_cube`].
@@ -93,7 +93,7 @@ impl TraversalStats for TraversalCounts {
 }
 
 /// True when the processor has what the queries' versions compiled for AVX2 use: AVX2 for
-/// a block's eight lanes, FMA for the walk's multiply-adds ([`Fused`]), POPCNT for an occupied cell's rank (without it, `count_ones` is
+/// a block's eight lanes, POPCNT for an occupied cell's rank (without it, `count_ones` is
 /// a seventeen-instruction bit trick on every step into an occupied cell), BMI1 and BMI2
 /// for bit tests and shifts. Every x86-64 processor with AVX2 has the other three; the
 /// check is cached by the standard library.
@@ -101,7 +101,6 @@ impl TraversalStats for TraversalCounts {
 #[inline]
 fn x86_fast_path() -> bool {
     std::is_x86_feature_detected!("avx2")
-        && std::is_x86_feature_detected!("fma")
         && std::is_x86_feature_detected!("popcnt")
         && std::is_x86_feature_detected!("bmi1")
         && std::is_x86_feature_detected!("bmi2")
@@ -124,31 +123,24 @@ impl Grid {
             // SAFETY: the processor has the features enabled there, checked just above.
             return unsafe { self.intersect_avx2(ray, stats) };
         }
-        self.intersect_portable::<Unfused>(ray, stats)
+        self.intersect_portable(ray, stats)
     }
 
     /// [`Grid::intersect_portable`] compiled for AVX2, where a block's eight lanes are one
-    /// vector (its arithmetic is the same), and FMA, where the walk's multiply-adds are
-    /// fused (face distances may differ from the portable walk's in the last bit, so a ray
-    /// through a cell's edge may visit its neighbours in another order; every hit still
-    /// lies in a cell the ray is in when it is accepted, so the nearest hit is the same).
+    /// vector (the arithmetic, and so the answer, is the same).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
     fn intersect_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
-        self.intersect_portable::<Fused>(ray, stats)
+        self.intersect_portable(ray, stats)
     }
 
     #[inline(always)]
-    fn intersect_portable<M: MulAdd>(
-        &self,
-        ray: &Ray,
-        stats: &mut impl TraversalStats,
-    ) -> Option<GridHit> {
+    fn intersect_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
         // The nearest hit found so far, wherever it lies; it is the answer once it lies
         // within the cell being visited, since every later cell lies beyond that cell.
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
-        let mut cells = self.occupied_cells::<true, M>(ray);
+        let mut cells = self.occupied_cells::<true>(ray);
         while let Some((range, limit)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
@@ -175,19 +167,19 @@ impl Grid {
             // SAFETY: the processor has the features enabled there, checked just above.
             return unsafe { self.walk_avx2(ray, t_stop) };
         }
-        self.walk_portable::<Unfused>(ray, t_stop)
+        self.walk_portable(ray, t_stop)
     }
 
     /// [`Grid::walk_portable`] compiled for AVX2, like the queries.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
     fn walk_avx2(&self, ray: &Ray, t_stop: f32) -> usize {
-        self.walk_portable::<Fused>(ray, t_stop)
+        self.walk_portable(ray, t_stop)
     }
 
     #[inline(always)]
-    fn walk_portable<M: MulAdd>(&self, ray: &Ray, t_stop: f32) -> usize {
-        let mut cells = self.occupied_cells::<false, M>(ray);
+    fn walk_portable(&self, ray: &Ray, t_stop: f32) -> usize {
+        let mut cells = self.occupied_cells::<false>(ray);
         let mut visited = 0;
         while let Some((_, limit)) = cells.next(&mut ()) {
             visited += 1;
@@ -210,19 +202,19 @@ impl Grid {
             // SAFETY: the processor has the features enabled there, checked just above.
             return unsafe { self.occluded_avx2(ray, stats) };
         }
-        self.occluded_portable::<Unfused>(ray, stats)
+        self.occluded_portable(ray, stats)
     }
 
     /// [`Grid::occluded_portable`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
     fn occluded_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.occluded_portable::<Fused>(ray, stats)
+        self.occluded_portable(ray, stats)
     }
 
     #[inline(always)]
-    fn occluded_portable<M: MulAdd>(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        let mut cells = self.occupied_cells::<true, M>(ray);
+    fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        let mut cells = self.occupied_cells::<true>(ray);
         while let Some((range, _)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
@@ -236,10 +228,10 @@ impl Grid {
 
     /// The occupied cells along `ray`, front to back.
     #[inline(always)]
-    fn occupied_cells<'a, const READ_BLOCKS: bool, M: MulAdd>(
+    fn occupied_cells<'a, const READ_BLOCKS: bool>(
         &'a self,
         ray: &Ray,
-    ) -> OccupiedCells<'a, READ_BLOCKS, M> {
+    ) -> OccupiedCells<'a, READ_BLOCKS> {
         let single_cell = self.frame.resolution == UVec3::ONE;
         let walk = if self.blocks.is_empty() || single_cell {
             None
@@ -259,10 +251,10 @@ impl Grid {
 /// The occupied cells along a ray, front to back (a cursor rather than an iterator, so the
 /// caller's statistics can ride along). Unless `READ_BLOCKS`, the cells' blocks are not
 /// asked for ahead of time ([`Grid::walk`]).
-struct OccupiedCells<'a, const READ_BLOCKS: bool, M> {
+struct OccupiedCells<'a, const READ_BLOCKS: bool> {
     grid: &'a Grid,
     /// `None` once the ray has left the grid.
-    walk: Option<CellWalk<M>>,
+    walk: Option<CellWalk>,
     /// The octant of the ray's direction ([`reach::octant`]).
     octant: u32,
     /// True until the one cell of a single-cell grid has been given out: such a grid is not
@@ -277,7 +269,7 @@ struct OccupiedCells<'a, const READ_BLOCKS: bool, M> {
 /// belongs to it (the last cell takes all up to the grid's end).
 type Found = (Range<usize>, f32);
 
-impl<const READ_BLOCKS: bool, M: MulAdd> OccupiedCells<'_, READ_BLOCKS, M> {
+impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
     /// The next occupied cell along the ray.
     ///
     /// The walk runs one occupied cell ahead of the cell given out. Reading a cell's
@@ -436,37 +428,6 @@ mod tests {
             "{total:?}"
         );
         assert!(total.cell_leaps > 0 && total.plain_steps > 0, "{total:?}");
-    }
-
-    /// The portable query (multiply-adds unfused) finds what the query compiled for this
-    /// processor finds (fused on one with FMA): the same nearest distance for every ray,
-    /// and the same triangle unless two lie at exactly that distance; the same shadow
-    /// answers.
-    #[test]
-    fn the_portable_walk_finds_what_the_fast_one_finds() {
-        let grid = Grid::build(sphere(90));
-        let mut rng = crate::render::sampling::Rng::new(29, 1);
-        let (mut hits, mut ties) = (0, 0);
-        for k in 0..20_000 {
-            let mut u = || rng.uniform() * 2.0 - 1.0;
-            let origin = Vec3::new(u(), u(), u()) * if k % 2 == 0 { 3.0 } else { 0.9 };
-            let direction = Vec3::new(u(), u(), u()).normalize();
-            let mut ray = Ray::new(origin, direction);
-            let fast = grid.intersect(&ray);
-            let portable = grid.intersect_portable::<Unfused>(&ray, &mut ());
-            assert_eq!(fast.map(|h| h.t), portable.map(|h| h.t), "ray {k}: {ray:?}");
-            if fast.map(|h| h.triangle) != portable.map(|h| h.triangle) {
-                ties += 1;
-            }
-            hits += usize::from(fast.is_some());
-            ray.t_max = 1.5;
-            assert_eq!(
-                grid.occluded(&ray),
-                grid.occluded_portable::<Unfused>(&ray, &mut ()),
-                "ray {k}: {ray:?}"
-            );
-        }
-        assert!(hits > 5_000 && ties <= 2, "{hits} hits, {ties} ties");
     }
 
     /// The walk alone, told where the nearest hit lies, gives out the occupied cells the
