@@ -430,6 +430,36 @@ mod tests {
         assert!(total.cell_leaps > 0 && total.plain_steps > 0, "{total:?}");
     }
 
+    /// The portable query (compiled for baseline x86-64 here) finds what the query
+    /// compiled for this processor finds: the same nearest hit for every ray, and the same
+    /// shadow answers.
+    #[test]
+    fn the_portable_walk_finds_what_the_fast_one_finds() {
+        let grid = Grid::build(sphere(90));
+        let mut rng = crate::render::sampling::Rng::new(29, 1);
+        let mut hits = 0;
+        for k in 0..20_000 {
+            let mut u = || rng.uniform() * 2.0 - 1.0;
+            let origin = Vec3::new(u(), u(), u()) * if k % 2 == 0 { 3.0 } else { 0.9 };
+            let direction = Vec3::new(u(), u(), u()).normalize();
+            let mut ray = Ray::new(origin, direction);
+            let fast = grid.intersect(&ray);
+            assert_eq!(
+                fast,
+                grid.intersect_portable(&ray, &mut ()),
+                "ray {k}: {ray:?}"
+            );
+            hits += usize::from(fast.is_some());
+            ray.t_max = 1.5;
+            assert_eq!(
+                grid.occluded(&ray),
+                grid.occluded_portable(&ray, &mut ()),
+                "ray {k}: {ray:?}"
+            );
+        }
+        assert!(hits > 5_000, "{hits} hits");
+    }
+
     /// The walk alone, told where the nearest hit lies, gives out the occupied cells the
     /// query visits (for rays that miss, all of them along the ray).
     #[test]
