@@ -12,10 +12,11 @@ pub(crate) const MAX_RESOLUTION: u32 = 2048;
 /// Most cells in one grid (per-cell build counters would otherwise be absurd).
 pub(crate) const MAX_CELLS: u64 = 1 << 28;
 
-/// The largest `1/d` of an axis a walk moves along: a smaller `|d|` counts as parallel
-/// (over any practical ray length it moves far less than rounding), so that no face
-/// distance `slope·k + offset` can overflow to ∞ − ∞ = NaN.
-const MOVING_INVERSE: f32 = 1e30;
+/// An axis along which the ray's direction is below this fraction of its largest
+/// component counts as parallel: over the ray's reach along the largest axis it moves by
+/// far less than rounding, and its face distances `slope·k + offset` stay far from
+/// overflow.
+const PARALLEL_FRACTION: f32 = 1e-20;
 
 /// A box tiled by `resolution` equal cells, numbered x fastest, then y, then z.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,10 +91,13 @@ impl GridFrame {
             return None;
         }
         let inv = direction.recip();
-        // An axis the ray is parallel to (or so nearly that 1/d nears overflow) does not move:
+        // An axis the ray is parallel to (or nearly: `PARALLEL_FRACTION`, or 1/d overflows)
+        // does not move:
         // slope 0 and offset ∞ put its faces at ∞, and its slab holds the whole ray or none
         // of it (0·∞ would be NaN for an origin on one of its planes).
-        let moving = inv.abs().cmplt(Vec3A::splat(MOVING_INVERSE));
+        let magnitude = direction.abs();
+        let moving = magnitude.cmpgt(Vec3A::splat(magnitude.max_element() * PARALLEL_FRACTION))
+            & inv.abs().cmplt(Vec3A::INFINITY);
         let (lo, hi) = (Vec3A::from(self.bounds.min), Vec3A::from(self.bounds.max));
         let t0 = (lo - origin) * inv;
         let t1 = (hi - origin) * inv;
@@ -220,7 +224,9 @@ impl CellWalk {
         let last = far - self.up;
         let next = far + self.up - Vec3A::ONE;
         let beyond = next.cmplt(Vec3A::ZERO) | next.cmpge(self.resolution_f);
-        if (t_exit >= self.t_end) | (beyond & chosen).any() {
+        // (No axis chosen only if a distance is NaN, which the parallel axes' handling
+        // rules out; the walk then ends rather than stand still.)
+        if (t_exit >= self.t_end) | (beyond & chosen).any() | !chosen.any() {
             return false;
         }
         // The cell under the exit point on the other axes (on an axis the ray is parallel
@@ -247,7 +253,7 @@ impl CellWalk {
         let next = self.face - self.up + moved;
         // Outside on that axis, or a face at or past the end: this cell was the last.
         let outside = next.cmplt(Vec3A::ZERO) | next.cmpge(self.resolution_f);
-        if outside.any() | (t_exit >= self.t_end) {
+        if outside.any() | (t_exit >= self.t_end) | !axis.any() {
             return (self.t_end, false);
         }
         self.cell = whole_cells(next);

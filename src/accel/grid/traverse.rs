@@ -464,6 +464,38 @@ mod tests {
         assert!(hits > 5_000, "{hits} hits");
     }
 
+    /// A ray whose direction is tiny (as a ray carried into the space of a hugely scaled
+    /// instance is) or has components far below the others finds what its normalised twin
+    /// finds, at the correspondingly scaled distance.
+    #[test]
+    fn a_ray_of_any_direction_length_finds_what_its_normalised_twin_finds() {
+        let grid = Grid::build(sphere(40));
+        let mut rng = crate::render::sampling::Rng::new(31, 2);
+        let mut hits = 0;
+        for k in 0..2_000 {
+            let mut u = || rng.uniform() * 2.0 - 1.0;
+            let origin = Vec3::new(u(), u(), u()) * 2.5;
+            let mut direction = Vec3::new(u(), u(), u()).normalize();
+            if k % 3 == 0 {
+                // Nearly parallel to an axis: the others a millionth of it.
+                direction = Vec3::new(1.0, 1e-6 * u(), 1e-6 * u()).normalize();
+            }
+            let twin = Ray::new(origin, direction);
+            let scale = if k % 2 == 0 { 1e-30 } else { 1e12 };
+            let scaled = Ray::new(origin, direction * scale);
+            let (a, b) = (grid.intersect(&twin), grid.intersect(&scaled));
+            assert_eq!(a.map(|h| h.triangle), b.map(|h| h.triangle), "ray {k}");
+            if let (Some(a), Some(b)) = (a, b) {
+                assert!(
+                    (b.t * scale / a.t - 1.0).abs() < 1e-4,
+                    "ray {k}: {a:?} {b:?}"
+                );
+                hits += 1;
+            }
+        }
+        assert!(hits > 100, "{hits} hits");
+    }
+
     /// The walk alone, told where the nearest hit lies, gives out the occupied cells the
     /// query visits (for rays that miss, all of them along the ray).
     #[test]
