@@ -5,6 +5,7 @@
 use glam::{BVec3A, IVec3, UVec3, Vec3, Vec3A, Vec3Swizzles};
 
 use super::Ray;
+use super::cell_lanes::CellLanes;
 use crate::scene::Aabb;
 
 /// Most cells along one axis.
@@ -138,8 +139,8 @@ impl GridFrame {
         let slope = Vec3A::select(moving, Vec3A::from(self.cell_size) * inv, Vec3A::ZERO);
         let offset = Vec3A::select(moving, t0, Vec3A::INFINITY);
         let mut walk = CellWalk {
-            cell: whole_cells(cell_f),
-            step: whole_cells(step_f),
+            cell: CellLanes::truncating(cell_f),
+            step: CellLanes::truncating(step_f),
             step_f,
             face: Vec3A::ZERO,
             slope,
@@ -164,15 +165,17 @@ impl GridFrame {
 /// without indexing vectors by a run-time axis, so the state stays in registers.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CellWalk {
-    /// Current cell.
-    pub cell: IVec3,
+    /// Current cell, in integer lanes: the next step's lookup starts from it
+    /// ([`CellLanes`]).
+    cell: CellLanes,
     /// −1, 0 or +1 per axis.
-    pub step: IVec3,
+    step: CellLanes,
     /// `step` as floats.
     step_f: Vec3A,
     /// The current cell's far face per axis, `cell + up`, as floats (whole numbers,
-    /// so exact): a step adds to it and the exit distances follow in one multiply-add,
-    /// without an integer-to-float conversion in the chain from one step to the next.
+    /// so exact): a plain step adds to it and the exit distances follow in one
+    /// multiply-add, without an integer-to-float conversion in the chain from one step to
+    /// the next (a leap converts its landing cell, beside the lookup that follows).
     face: Vec3A,
     /// The ray crosses the plane of cell face `k` on axis `a` at `t = slope[a]·k + offset[a]`
     /// (∞ for an axis the ray is parallel to): face distances come from whole-number face
@@ -196,22 +199,23 @@ pub(crate) struct CellWalk {
 }
 
 impl CellWalk {
-    /// Moves the walk out of the empty cube of `side` units of `unit` cells a side (units
-    /// aligned to multiples of `unit`) that has the current cell's unit as its corner and
-    /// extends in the ray's direction, to the first cell beyond it along the ray; false
-    /// when the ray leaves the grid or ends first. On the axes it does not leave the cube
-    /// by, the walk lands in the cell under the exit point, kept within the cube and never
-    /// behind its current cell, so rounding cannot move it backwards or sideways. In
+    /// Moves the walk out of the empty cube of `side` units of `2^unit_shift` cells a side
+    /// (units aligned to multiples of their size) that has the current cell's unit as its
+    /// corner and extends in the ray's direction, to the first cell beyond it along the ray;
+    /// false when the ray leaves the grid or ends first. On the axes it does not leave the
+    /// cube by, the walk lands in the cell under the exit point, kept within the cube and
+    /// never behind its current cell, so rounding cannot move it backwards or sideways. In
     /// vector lanes and whole-number floats (exact up to 2²⁴ cells), branch-free on the
     /// exit axis like [`CellWalk::advance`].
     #[inline(always)]
-    pub fn leave_cube(&mut self, side: f32, unit: f32) -> bool {
+    pub fn leave_cube(&mut self, side: f32, unit_shift: u32) -> bool {
+        let unit = (1 << unit_shift) as f32;
         let cell = self.face - self.up;
-        // (For cubes of cells, the cell is its own unit: no rounding in the chain.)
-        let base = if unit == 1.0 {
+        // The cube's corner unit, from the integer cell (for cubes of cells, the cell).
+        let base = if unit_shift == 0 {
             cell
         } else {
-            truncate(cell * (1.0 / unit)) * unit
+            self.cell.round_down(unit_shift).to_floats()
         };
         // The cube's far faces: past `base` by `side` units upwards, or `side − 1` below
         // `base` downwards (`base + unit − side·unit`); within the grid.
@@ -226,18 +230,19 @@ impl CellWalk {
         let beyond = next.cmplt(Vec3A::ZERO) | next.cmpge(self.resolution_f);
         // (No axis chosen only if a distance is NaN, which the parallel axes' handling
         // rules out; the walk then ends rather than stand still.)
-        if (t_exit >= self.t_end) | (beyond & chosen).any() | !chosen.any() {
+        if (t_exit.x >= self.t_end) | (beyond & chosen).any() | !chosen.any() {
             return false;
         }
         // The cell under the exit point on the other axes (on an axis the ray is parallel
-        // to, its own cell: `cells_at_zero` holds it there and `cells_per_t` is 0).
-        // (Truncated, not rounded down: a coordinate within rounding below 0 becomes 0
-        // instead of −1, and the clamp below raises it to 0 or more either way.)
-        let under = truncate(self.cells_per_t * Vec3A::splat(t_exit) + self.cells_at_zero);
-        let side_cell = under.clamp(cell.min(last), cell.max(last));
-        let landed = Vec3A::select(chosen, next, side_cell);
-        self.cell = whole_cells(landed);
-        self.face = landed + self.up;
+        // to, its own cell: `cells_at_zero` holds it there and `cells_per_t` is 0), kept
+        // within the cube and never behind the current cell. Clamped before it is
+        // truncated (the bounds are whole numbers ≥ 0, so truncating commutes with the
+        // clamp), and a NaN coordinate becomes the lower bound (`max` returns its second
+        // operand then): one conversion on the way to the next lookup.
+        let under = self.cells_per_t * t_exit + self.cells_at_zero;
+        let side_cell = under.max(cell.min(last)).min(cell.max(last));
+        self.cell = CellLanes::truncating(Vec3A::select(chosen, next, side_cell));
+        self.face = self.cell.to_floats() + self.up;
         self.t_next = self.slope * self.face + self.offset;
         true
     }
@@ -253,23 +258,37 @@ impl CellWalk {
         let next = self.face - self.up + moved;
         // Outside on that axis, or a face at or past the end: this cell was the last.
         let outside = next.cmplt(Vec3A::ZERO) | next.cmpge(self.resolution_f);
-        if outside.any() | (t_exit >= self.t_end) | !axis.any() {
+        if outside.any() | (t_exit.x >= self.t_end) | !axis.any() {
             return (self.t_end, false);
         }
-        self.cell = whole_cells(next);
+        self.cell = self
+            .cell
+            .add(CellLanes::select(axis, self.step, CellLanes::zero()));
         self.face += moved;
         self.t_next = self.slope * self.face + self.offset;
-        (t_exit, true)
+        (t_exit.x, true)
+    }
+
+    /// The current cell.
+    #[inline(always)]
+    pub fn cell(&self) -> IVec3 {
+        self.cell.ivec3()
+    }
+
+    /// −1, 0 or +1 per axis: the direction the walk moves along each.
+    #[inline(always)]
+    pub fn step(&self) -> IVec3 {
+        self.step.ivec3()
     }
 }
 
-/// Where a ray first reaches one of the faces it crosses at `t` (per axis), and on which
-/// axis, as a lane mask (x before y before z on ties, so a walk never moves on two axes at
-/// once). The mask comes from comparing the lanes with their rotations, in parallel with
-/// the least distance rather than after it (the walk's steps are one chain of dependent
-/// operations, so its length is what a step costs).
+/// Where a ray first reaches one of the faces it crosses at `t` (per axis; in every lane),
+/// and on which axis, as a lane mask (x before y before z on ties, so a walk never moves on
+/// two axes at once). The mask comes from comparing the lanes with their rotations, in
+/// parallel with the least distance rather than after it (the walk's steps are one chain of
+/// dependent operations, so its length is what a step costs).
 #[inline(always)]
-fn first_exit(t: Vec3A) -> (f32, BVec3A) {
+fn first_exit(t: Vec3A) -> (Vec3A, BVec3A) {
     let (next, after) = (t.yzx(), t.zxy());
     // Per lane: at or before the next lane, strictly before it, at or before the lane
     // after, strictly before it — x wins if t.x ≤ t.y and t.x ≤ t.z, y if t.y ≤ t.z and
@@ -280,15 +299,8 @@ fn first_exit(t: Vec3A) -> (f32, BVec3A) {
     let y = BVec3A::new(false, true, false);
     let first =
         (x & le_next & le_after) | (y & le_next & lt_after) | (!(x | y) & lt_next & lt_after);
-    (least(t), first)
-}
-
-/// The least of `v`'s three lanes, none of them NaN (an axis the ray is parallel to has
-/// its faces at ∞), without `f32::min`'s handling of NaN.
-#[inline(always)]
-fn least(v: Vec3A) -> f32 {
-    let min = |a: f32, b: f32| if a < b { a } else { b };
-    min(min(v.x, v.y), v.z)
+    // The least lane in every lane, from the same rotations: no broadcast after it.
+    (t.min(next).min(after), first)
 }
 
 /// `v` rounded towards zero (as whole-number floats): `floor` for the non-negative
@@ -303,22 +315,6 @@ fn truncate(v: Vec3A) -> Vec3A {
     }
     #[cfg(not(target_arch = "x86_64"))]
     v.trunc()
-}
-
-/// Cell coordinates held as whole-number floats (in the grid, so in range), converted by
-/// truncation in one instruction: `as` would check each lane for overflow and NaN.
-#[inline(always)]
-fn whole_cells(v: Vec3A) -> IVec3 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{__m128, __m128i, _mm_cvttps_epi32};
-        // SAFETY: SSE2, which this intrinsic needs, is part of x86_64.
-        let lanes: [i32; 4] =
-            unsafe { std::mem::transmute::<__m128i, [i32; 4]>(_mm_cvttps_epi32(__m128::from(v))) };
-        IVec3::new(lanes[0], lanes[1], lanes[2])
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    v.as_ivec3()
 }
 
 /// The box grown by a small fraction of its size, so flat contents get a volume and nothing
@@ -389,16 +385,16 @@ mod tests {
         );
         let ray = Ray::new(Vec3::new(-1.0, 0.5, 0.5), Vec3::new(1.0, 0.0, 0.0));
         let mut walk = frame.start_walk(&ray).unwrap();
-        let mut cells = vec![walk.cell];
+        let mut cells = vec![walk.cell()];
         loop {
-            let x = walk.cell.x;
+            let x = walk.cell().x;
             let (t, more) = walk.advance();
             if !more {
                 assert_eq!(t, walk.t_end);
                 break;
             }
             assert_eq!(t, (x + 2) as f32);
-            cells.push(walk.cell);
+            cells.push(walk.cell());
         }
         assert_eq!(
             cells,
@@ -436,15 +432,15 @@ mod tests {
             };
             let unit = if k % 2 == 0 { 1 } else { 8 };
             let side = 1 + (k / 2 % 4) as i32;
-            let base = start.cell.div_euclid(IVec3::splat(unit)) * unit;
+            let base = start.cell().div_euclid(IVec3::splat(unit)) * unit;
             let (lo, hi) = (
                 IVec3::select(
-                    start.step.cmpgt(IVec3::ZERO),
+                    start.step().cmpgt(IVec3::ZERO),
                     base,
                     base - (side - 1) * unit,
                 ),
                 IVec3::select(
-                    start.step.cmpgt(IVec3::ZERO),
+                    start.step().cmpgt(IVec3::ZERO),
                     base + side * unit - 1,
                     base + unit - 1,
                 ),
@@ -454,15 +450,15 @@ mod tests {
                 if !cell_walk.advance().1 {
                     break None;
                 }
-                let c = cell_walk.cell;
+                let c = cell_walk.cell();
                 if c.cmplt(lo).any() || c.cmpgt(hi).any() {
                     break Some(c);
                 }
             };
             let mut leap = start;
             let got = leap
-                .leave_cube(side as f32, unit as f32)
-                .then_some(leap.cell);
+                .leave_cube(side as f32, unit.trailing_zeros())
+                .then_some(leap.cell());
             if got == expected {
                 agreed += 1;
                 continue;

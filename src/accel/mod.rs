@@ -2,6 +2,7 @@
 //! and a top level over the instances (a list, or a grid of their own when there are many).
 
 mod box_lanes;
+mod cell_lanes;
 mod frame;
 pub mod grid;
 mod huge_pages;

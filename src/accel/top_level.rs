@@ -103,7 +103,7 @@ impl InstanceGrid {
             return;
         };
         loop {
-            let c = self.frame.cell_index(walk.cell.as_uvec3());
+            let c = self.frame.cell_index(walk.cell().as_uvec3());
             let ids = &self.ids[self.offsets[c] as usize..self.offsets[c + 1] as usize];
             let (limit, more) = walk.advance();
             if !ids.is_empty() && visit(ids, limit) {

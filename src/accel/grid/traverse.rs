@@ -17,9 +17,6 @@ use crate::accel::Ray;
 use crate::accel::frame::CellWalk;
 use crate::accel::prefetch::prefetch;
 
-/// Cells along a macrocell's edge, as the unit of [`CellWalk::leave_cube`].
-const MACROCELL_SIDE: f32 = (1 << MACRO_SHIFT) as f32;
-
 /// Counts the work a traversal does, for the benchmark's statistics. The unit type counts
 /// nothing and compiles away.
 pub trait TraversalStats {
@@ -244,7 +241,7 @@ impl Grid {
         };
         OccupiedCells {
             grid: self,
-            octant: walk.map_or(0, |w| reach::octant(w.step)),
+            octant: walk.map_or(0, |w| reach::octant(w.step())),
             walk,
             single_cell: single_cell && !self.blocks.is_empty(),
             ahead: None,
@@ -308,7 +305,7 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
         let walk = self.walk.as_mut()?;
         loop {
             stats.visit_cell();
-            let record = match grid.cells.macrocell_of(walk.cell, self.octant) {
+            let record = match grid.cells.macrocell_of(walk.cell(), self.octant) {
                 Ok(record) => {
                     stats.enter_macrocell();
                     grid.cells.prefetch_record(record, self.octant);
@@ -317,7 +314,7 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
                 Err(reach) => {
                     stats.leap_macrocells();
                     // Past the empty cube of `reach` macrocells ahead ([`reach`]).
-                    if !walk.leave_cube(reach.max(1) as f32, MACROCELL_SIDE) {
+                    if !walk.leave_cube(reach.max(1) as f32, MACRO_SHIFT as u32) {
                         self.walk = None;
                         return None;
                     }
@@ -326,16 +323,16 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
             };
             // Within one occupied macrocell, its record serves every step until the walk
             // leaves it: no macrocell lookup per cell.
-            let macrocell = walk.cell >> MACRO_SHIFT;
+            let macrocell = walk.cell() >> MACRO_SHIFT;
             loop {
-                match grid.cells.lookup_in(record, walk.cell, self.octant) {
+                match grid.cells.lookup_in(record, walk.cell(), self.octant) {
                     // A cell whose reach is 1 is left by an ordinary step: cheaper than
                     // leaving a cube of one cell.
                     Lookup::EmptyCell { reach } if reach >= 2 => {
                         stats.leap_cells();
                         // Past the empty cube of `reach` cells ahead
                         // ([`super::cell_reach`]).
-                        if !walk.leave_cube(reach as f32, 1.0) {
+                        if !walk.leave_cube(reach as f32, 0) {
                             self.walk = None;
                             return None;
                         }
@@ -363,7 +360,7 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
                         }
                     }
                 }
-                if walk.cell >> MACRO_SHIFT != macrocell {
+                if walk.cell() >> MACRO_SHIFT != macrocell {
                     break;
                 }
                 stats.visit_cell();
