@@ -151,6 +151,8 @@ impl GridFrame {
             cells_at_zero: Vec3A::select(moving, -offset * cells_per_t, cell_f + Vec3A::splat(0.5)),
             up: Vec3A::select(up, Vec3A::ONE, Vec3A::ZERO),
             resolution_f,
+            t_per_cell: slope * step_f,
+            t_bound: slope * Vec3A::select(up, resolution_f, Vec3A::ZERO) + offset,
         };
         walk.face = cell_f + walk.up;
         walk.t_next = walk.slope * walk.face + walk.offset;
@@ -196,6 +198,12 @@ pub(crate) struct CellWalk {
     up: Vec3A,
     /// `resolution` as floats.
     resolution_f: Vec3A,
+    /// How much later the ray crosses a face one cell further along each axis
+    /// (`slope·step`, ≥ 0; 0 for an axis the ray is parallel to).
+    t_per_cell: Vec3A,
+    /// Where the ray crosses the grid's last face along each axis (∞ for an axis the ray
+    /// is parallel to).
+    t_bound: Vec3A,
 }
 
 impl CellWalk {
@@ -219,10 +227,18 @@ impl CellWalk {
         };
         // The cube's far faces: past `base` by `side` units upwards, or `side − 1` below
         // `base` downwards (`base + unit − side·unit`); within the grid.
-        let down_unit = (Vec3A::ONE - self.up) * unit;
-        let far = (self.step_f * Vec3A::splat(side * unit) + (base + down_unit))
-            .clamp(Vec3A::ZERO, self.resolution_f);
-        let (t_exit, chosen) = first_exit(self.slope * far + self.offset);
+        let corner = base + (Vec3A::ONE - self.up) * unit;
+        let reach = Vec3A::splat(side * unit);
+        let far = (self.step_f * reach + corner).clamp(Vec3A::ZERO, self.resolution_f);
+        // Where the ray crosses them: `slope·far + offset`, expanded so that the reach,
+        // the last value to arrive, enters in one multiply-add, and clamped to the grid's
+        // last faces in `t` rather than in face numbers (the same faces: `t` grows along
+        // the walk). Rounding may differ from `slope·far + offset` by a few ulps, as any
+        // two roundings of a tie do; the landing cell is kept within the cube or on the
+        // exit axis just beyond it either way.
+        let t_far =
+            (self.t_per_cell * reach + (self.slope * corner + self.offset)).min(self.t_bound);
+        let (t_exit, chosen) = first_exit(t_far);
         // The cube's last cells (`far − 1` upwards, `far` downwards), and the cell beyond
         // on the exit axis (`far` upwards, `far − 1` downwards).
         let last = far - self.up;
