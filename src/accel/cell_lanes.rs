@@ -19,7 +19,8 @@ pub(crate) struct CellLanes(
 mod lanes {
     pub use std::arch::x86_64::{
         __m128, __m128i, _mm_add_epi32, _mm_and_si128, _mm_andnot_si128, _mm_castps_si128,
-        _mm_cvtepi32_ps, _mm_cvttps_epi32, _mm_or_si128, _mm_set1_epi32, _mm_setzero_si128,
+        _mm_cmpgt_epi32, _mm_cvtepi32_ps, _mm_cvttps_epi32, _mm_or_si128, _mm_set1_epi32,
+        _mm_setzero_si128,
     };
 }
 
@@ -87,23 +88,49 @@ impl CellLanes {
         CellLanes(self.0 & IVec3::splat(!((1 << shift) - 1)))
     }
 
+    /// Each coordinate raised to at least `lo`'s and lowered to at most `hi`'s. (Written
+    /// with SSE2 comparisons; compiled with SSE4.1 or later, each half is one `pmaxsd` or
+    /// `pminsd`.)
+    #[inline(always)]
+    pub fn clamp(self, lo: CellLanes, hi: CellLanes) -> CellLanes {
+        #[cfg(target_arch = "x86_64")]
+        return unsafe {
+            let raised = CellLanes::select_lanes(lanes::_mm_cmpgt_epi32(lo.0, self.0), lo, self);
+            CellLanes::select_lanes(lanes::_mm_cmpgt_epi32(raised.0, hi.0), hi, raised)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        CellLanes(self.0.clamp(lo.0, hi.0))
+    }
+
     /// `a` in the lanes of `mask`, `b` in the others.
     #[inline(always)]
     pub fn select(mask: BVec3A, a: CellLanes, b: CellLanes) -> CellLanes {
         #[cfg(target_arch = "x86_64")]
-        return CellLanes(unsafe {
-            let m = lanes::_mm_castps_si128(lanes::__m128::from(mask));
-            lanes::_mm_or_si128(
-                lanes::_mm_and_si128(m, a.0),
-                lanes::_mm_andnot_si128(m, b.0),
-            )
-        });
+        return CellLanes::select_lanes(
+            unsafe { lanes::_mm_castps_si128(lanes::__m128::from(mask)) },
+            a,
+            b,
+        );
         #[cfg(not(target_arch = "x86_64"))]
         CellLanes(IVec3::select(
             glam::BVec3::new(mask.test(0), mask.test(1), mask.test(2)),
             a.0,
             b.0,
         ))
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl CellLanes {
+    /// `a` in the lanes where `mask` is all ones, `b` where it is zero.
+    #[inline(always)]
+    fn select_lanes(mask: lanes::__m128i, a: CellLanes, b: CellLanes) -> CellLanes {
+        CellLanes(unsafe {
+            lanes::_mm_or_si128(
+                lanes::_mm_and_si128(mask, a.0),
+                lanes::_mm_andnot_si128(mask, b.0),
+            )
+        })
     }
 }
 
@@ -125,5 +152,9 @@ mod tests {
             IVec3::new(13, 1, 2047)
         );
         assert_eq!(CellLanes::zero().ivec3(), IVec3::ZERO);
+        let (lo, hi) = (CellLanes::zero(), CellLanes::truncating(Vec3A::splat(12.0)));
+        assert_eq!(c.clamp(lo, hi).ivec3(), IVec3::new(12, 0, 12));
+        let below = CellLanes::truncating(Vec3A::new(-3.0, f32::NAN, 5.0));
+        assert_eq!(below.clamp(lo, hi).ivec3(), IVec3::new(0, 0, 5));
     }
 }

@@ -251,13 +251,15 @@ impl CellWalk {
         }
         // The cell under the exit point on the other axes (on an axis the ray is parallel
         // to, its own cell: `cells_at_zero` holds it there and `cells_per_t` is 0), kept
-        // within the cube and never behind the current cell. Clamped before it is
-        // truncated (the bounds are whole numbers ≥ 0, so truncating commutes with the
-        // clamp), and a NaN coordinate becomes the lower bound (`max` returns its second
-        // operand then): one conversion on the way to the next lookup.
-        let under = self.cells_per_t * t_exit + self.cells_at_zero;
-        let side_cell = under.max(cell.min(last)).min(cell.max(last));
-        self.cell = CellLanes::truncating(Vec3A::select(chosen, next, side_cell));
+        // within the cube and never behind the current cell; truncated, then clamped and
+        // chosen in integer lanes (one conversion and three one-cycle operations on the way
+        // to the next lookup). A NaN or out-of-range coordinate (which a point of the ray
+        // within the grid does not have) truncates to `i32::MIN`, so the clamp puts it on
+        // the cube's near side; the walk goes on from there.
+        let under = CellLanes::truncating(self.cells_per_t * t_exit + self.cells_at_zero);
+        let (lo, hi) = (cell.min(last), cell.max(last));
+        let side_cell = under.clamp(CellLanes::truncating(lo), CellLanes::truncating(hi));
+        self.cell = CellLanes::select(chosen, CellLanes::truncating(next), side_cell);
         self.face = self.cell.to_floats() + self.up;
         self.t_next = self.slope * self.face + self.offset;
         true
