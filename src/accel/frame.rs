@@ -152,7 +152,6 @@ impl GridFrame {
             up: Vec3A::select(up, Vec3A::ONE, Vec3A::ZERO),
             resolution_f,
             t_per_cell: slope * step_f,
-            t_bound: slope * Vec3A::select(up, resolution_f, Vec3A::ZERO) + offset,
         };
         walk.face = cell_f + walk.up;
         walk.t_next = walk.slope * walk.face + walk.offset;
@@ -201,9 +200,6 @@ pub(crate) struct CellWalk {
     /// How much later the ray crosses a face one cell further along each axis
     /// (`slope·step`, ≥ 0; 0 for an axis the ray is parallel to).
     t_per_cell: Vec3A,
-    /// Where the ray crosses the grid's last face along each axis (∞ for an axis the ray
-    /// is parallel to).
-    t_bound: Vec3A,
 }
 
 impl CellWalk {
@@ -231,13 +227,19 @@ impl CellWalk {
         let reach = Vec3A::splat(side * unit);
         let far = (self.step_f * reach + corner).clamp(Vec3A::ZERO, self.resolution_f);
         // Where the ray crosses them: `slope·far + offset`, expanded so that the reach,
-        // the last value to arrive, enters in one multiply-add, and clamped to the grid's
-        // last faces in `t` rather than in face numbers (the same faces: `t` grows along
-        // the walk). Rounding may differ from `slope·far + offset` by a few ulps, as any
-        // two roundings of a tie do; the landing cell is kept within the cube or on the
-        // exit axis just beyond it either way.
-        let t_far =
-            (self.t_per_cell * reach + (self.slope * corner + self.offset)).min(self.t_bound);
+        // the last value to arrive, enters in one multiply-add (for a cube of cells, the
+        // rest is the current cell's exit distances one cell back). Not clamped to the
+        // grid: where a face lies beyond it, the ray leaves the grid first, at `t_end` or
+        // within its rounding, and the checks below end the walk (or land it in the
+        // cube's last cell). Rounding may differ from `slope·far + offset` by a few ulps,
+        // as any two roundings of a tie do; the landing cell is kept within the cube or
+        // on the exit axis just beyond it either way.
+        let at_corner = if unit_shift == 0 {
+            self.t_next - self.t_per_cell
+        } else {
+            self.slope * corner + self.offset
+        };
+        let t_far = self.t_per_cell * reach + at_corner;
         let (t_exit, chosen) = first_exit(t_far);
         // The cube's last cells (`far − 1` upwards, `far` downwards), and the cell beyond
         // on the exit axis (`far` upwards, `far − 1` downwards).
