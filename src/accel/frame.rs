@@ -256,8 +256,9 @@ impl CellWalk {
         // within the cube and never behind the current cell; truncated, then clamped and
         // chosen in integer lanes (one conversion and three one-cycle operations on the way
         // to the next lookup). A NaN or out-of-range coordinate (which a point of the ray
-        // within the grid does not have) truncates to `i32::MIN`, so the clamp puts it on
-        // the cube's near side; the walk goes on from there.
+        // within the grid does not have) truncates to `i32::MIN` on x86-64 (elsewhere `as`
+        // saturates), so the clamp puts it on one of the cube's sides; the walk goes on
+        // from there.
         let under = CellLanes::truncating(self.cells_per_t * t_exit + self.cells_at_zero);
         let (lo, hi) = (cell.min(last), cell.max(last));
         let side_cell = under.clamp(CellLanes::truncating(lo), CellLanes::truncating(hi));
