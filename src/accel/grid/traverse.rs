@@ -32,6 +32,9 @@ pub trait TraversalStats {
     fn step_cell(&mut self) {}
     /// One occupied cell reached (its triangles are then tested).
     fn visit_occupied(&mut self) {}
+    /// The walk ahead of a tested cell stopped at the next occupied macrocell
+    /// ([`OccupiedCells::next`]).
+    fn pause_ahead(&mut self) {}
     /// Ray–triangle tests (the triangles of one block, tested together).
     fn test_triangles(&mut self, _count: usize) {}
     /// One instance considered by the top level (its bounding box tested, and its grid
@@ -56,6 +59,8 @@ pub struct TraversalCounts {
     pub plain_steps: u64,
     /// Occupied cells reached.
     pub occupied: u64,
+    /// Walks ahead of a tested cell stopped at the next occupied macrocell.
+    pub pauses: u64,
     /// Ray–triangle tests.
     pub tests: u64,
     /// Instances considered by the top level.
@@ -80,6 +85,9 @@ impl TraversalStats for TraversalCounts {
     }
     fn visit_occupied(&mut self) {
         self.occupied += 1;
+    }
+    fn pause_ahead(&mut self) {
+        self.pauses += 1;
     }
     fn test_triangles(&mut self, count: usize) {
         self.tests += count as u64;
@@ -245,6 +253,11 @@ impl Grid {
             walk,
             single_cell: single_cell && !self.blocks.is_empty(),
             ahead: None,
+            last_record: usize::MAX,
+            pause_ahead: {
+                let (origin, bounds) = (ray.origin, self.frame.bounds);
+                origin.cmplt(bounds.min).any() || origin.cmpgt(bounds.max).any()
+            },
         }
     }
 }
@@ -261,9 +274,32 @@ struct OccupiedCells<'a, const READ_BLOCKS: bool> {
     /// True until the one cell of a single-cell grid has been given out: such a grid is not
     /// walked (a few triangles are tested faster all at once than found by a walk).
     single_cell: bool,
-    /// The occupied cell after the one given out last, found ahead of time; `None` before
-    /// the first is given out.
-    ahead: Option<Option<Found>>,
+    /// The walk ahead of the cell given out last; `None` before the first is given out.
+    ahead: Option<Ahead>,
+    /// The record of the macrocell of the cell given out last.
+    last_record: usize,
+    /// True when the walk ahead of a cell stops at the next occupied macrocell: for a ray
+    /// that starts outside the grid's box ([`OccupiedCells::next`]).
+    pause_ahead: bool,
+}
+
+/// How far the walk ahead of the cell being tested went.
+enum Ahead {
+    /// To the next occupied cell (`None`: the ray leaves the grid without one).
+    Found(Option<Found>),
+    /// To an occupied macrocell other than the tested cell's, whose record it has asked
+    /// for; the walk goes on from there when the cell being tested holds no hit.
+    Paused,
+}
+
+impl Ahead {
+    /// The cell found, for a walk that may not pause (which finds one or leaves the grid).
+    fn into_found(self) -> Option<Found> {
+        match self {
+            Ahead::Found(found) => found,
+            Ahead::Paused => unreachable!("a walk that may not pause paused"),
+        }
+    }
 }
 
 /// An occupied cell: where its blocks lie in `blocks`, and the largest hit parameter that
@@ -280,6 +316,15 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
     /// tests of the cell before. Two cells ahead gained 1.00–1.03× on the full dragon's
     /// bounce rays but lost 0.89× on its outside rays: cells found beyond the hit are
     /// wasted work.
+    ///
+    /// For the same reason, a ray that starts outside the grid's box — which meets the
+    /// outside of the surface first, and most often hits it in the first occupied cells it
+    /// finds — stops its walk ahead at the next occupied macrocell other than the tested
+    /// cell's, having asked for that macrocell's record: the walk does not wait for a
+    /// record from memory that the tested cell's hit may make useless, and goes on from
+    /// there, the record on its way, if the cell holds none. A ray that starts inside
+    /// (bounce and shadow rays, leaving the surface they start on) walks on as before:
+    /// stopping cost its bounce rays 0.93× the speed.
     #[inline(always)]
     fn next(&mut self, stats: &mut impl TraversalStats) -> Option<Found> {
         let grid = self.grid;
@@ -290,22 +335,34 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
             return Some((0..grid.blocks.len(), f32::INFINITY));
         }
         let current = match self.ahead.take() {
-            Some(ahead) => ahead,
-            None => self.find_next(stats),
+            Some(Ahead::Found(found)) => found,
+            // Before the first cell, or on from where the walk ahead stopped.
+            Some(Ahead::Paused) | None => self.find_next(stats, false).into_found(),
         }?;
-        self.ahead = Some(self.find_next(stats));
+        self.ahead = Some(self.find_next(stats, self.pause_ahead));
         stats.visit_occupied();
         Some(current)
     }
 
-    /// The walk on to the next occupied cell: its blocks and hit limit.
+    /// The walk on to the next occupied cell: its blocks and hit limit; if `pause`, it stops
+    /// instead at an occupied macrocell other than that of the cell given out last.
     #[inline(always)]
-    fn find_next(&mut self, stats: &mut impl TraversalStats) -> Option<Found> {
+    fn find_next(&mut self, stats: &mut impl TraversalStats, pause: bool) -> Ahead {
         let grid = self.grid;
-        let walk = self.walk.as_mut()?;
+        let Some(walk) = self.walk.as_mut() else {
+            return Ahead::Found(None);
+        };
         loop {
+            let word = grid.cells.macrocell_of(walk.cell(), self.octant);
+            if let (true, Ok(record)) = (pause, word)
+                && record != self.last_record
+            {
+                grid.cells.prefetch_record(record, self.octant);
+                stats.pause_ahead();
+                return Ahead::Paused;
+            }
             stats.visit_cell();
-            let record = match grid.cells.macrocell_of(walk.cell(), self.octant) {
+            let record = match word {
                 Ok(record) => {
                     stats.enter_macrocell();
                     grid.cells.prefetch_record(record, self.octant);
@@ -316,7 +373,7 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
                     // Past the empty cube of `reach` macrocells ahead ([`reach`]).
                     if !walk.leave_cube(reach.max(1) as f32, MACRO_SHIFT as u32) {
                         self.walk = None;
-                        return None;
+                        return Ahead::Found(None);
                     }
                     continue;
                 }
@@ -334,7 +391,7 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
                         // ([`super::cell_reach`]).
                         if !walk.leave_cube(reach as f32, 0) {
                             self.walk = None;
-                            return None;
+                            return Ahead::Found(None);
                         }
                     }
                     Lookup::Blocks(range) => {
@@ -349,14 +406,15 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
                         if !more {
                             self.walk = None;
                         }
-                        return Some((range, limit));
+                        self.last_record = record;
+                        return Ahead::Found(Some((range, limit)));
                     }
                     // (`lookup_in` never answers `EmptyMacrocell`.)
                     Lookup::EmptyCell { .. } | Lookup::EmptyMacrocell => {
                         stats.step_cell();
                         if !walk.advance().1 {
                             self.walk = None;
-                            return None;
+                            return Ahead::Found(None);
                         }
                     }
                 }
@@ -429,6 +487,48 @@ mod tests {
             "{total:?}"
         );
         assert!(total.cell_leaps > 0 && total.plain_steps > 0, "{total:?}");
+    }
+
+    /// A ray from outside the grid's box, whose walk ahead stops at each new occupied
+    /// macrocell and goes on from there when the tested cell holds no hit, finds the
+    /// nearest hit that testing every triangle finds, and so does a shadow ray.
+    #[test]
+    fn a_walk_that_pauses_ahead_finds_the_nearest_hit() {
+        let triangles = sphere(120);
+        let grid = Grid::build(triangles.clone());
+        let mut rng = crate::render::sampling::Rng::new(37, 3);
+        let (mut counts, mut hits) = (TraversalCounts::default(), 0);
+        for k in 0..3_000 {
+            let mut u = || rng.uniform() * 2.0 - 1.0;
+            let origin = Vec3::new(u(), u(), u()).normalize() * 3.0;
+            // Aimed near the sphere's rim, so many rays pass occupied cells before a hit.
+            let target = Vec3::new(u(), u(), u()) * 1.05;
+            let mut ray = Ray::new(origin, (target - origin).normalize());
+            let nearest = triangles.iter().enumerate().fold(
+                None,
+                |best: Option<(f32, usize)>, (i, t)| match t
+                    .intersect(&ray, best.map_or(ray.t_max, |b| b.0))
+                {
+                    Some(hit) => Some((hit.t, i)),
+                    None => best,
+                },
+            );
+            let found = grid.intersect_counting(&ray, &mut counts);
+            assert_eq!(
+                found.map(|h| (h.t, h.triangle as usize)),
+                nearest,
+                "ray {k}: {ray:?}"
+            );
+            hits += usize::from(nearest.is_some());
+            ray.t_max = nearest.map_or(4.0, |n| n.0 * 0.999);
+            assert!(!grid.occluded(&ray), "ray {k}: {ray:?}");
+            ray.t_max = nearest.map_or(4.0, |n| n.0 * 1.001);
+            assert_eq!(grid.occluded(&ray), nearest.is_some(), "ray {k}: {ray:?}");
+        }
+        assert!(
+            hits > 1_000 && counts.pauses > 500,
+            "{hits} hits, {counts:?}"
+        );
     }
 
     /// The portable query (compiled for baseline x86-64 here) finds what the query
