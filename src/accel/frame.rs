@@ -147,6 +147,7 @@ impl GridFrame {
             offset,
             t_next: Vec3A::INFINITY,
             t_end,
+            from_outside: !inside.all(),
             cells_per_t,
             cells_at_zero: Vec3A::select(moving, -offset * cells_per_t, cell_f + Vec3A::splat(0.5)),
             up: Vec3A::select(up, Vec3A::ONE, Vec3A::ZERO),
@@ -187,6 +188,8 @@ pub(crate) struct CellWalk {
     t_next: Vec3A,
     /// Ray parameter at which the ray leaves the grid (or reaches `t_max`).
     pub t_end: f32,
+    /// True when the ray starts outside the grid's box (or on its boundary).
+    pub from_outside: bool,
     /// Cells crossed per unit of `t` on each axis (0 for an axis the ray is parallel to):
     /// the cell coordinate at `t` is `(t − offset)·cells_per_t`.
     cells_per_t: Vec3A,

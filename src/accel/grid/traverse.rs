@@ -254,10 +254,7 @@ impl Grid {
             single_cell: single_cell && !self.blocks.is_empty(),
             ahead: None,
             last_record: usize::MAX,
-            pause_ahead: {
-                let (origin, bounds) = (ray.origin, self.frame.bounds);
-                origin.cmplt(bounds.min).any() || origin.cmpgt(bounds.max).any()
-            },
+            pause_ahead: walk.is_some_and(|w| w.from_outside),
         }
     }
 }
