@@ -24,12 +24,11 @@ mod oracles;
 
 use std::time::{Duration, Instant};
 
-use glam::Vec3;
 use gridtrace::accel::{Grid, Ray, TraversalCounts};
 use gridtrace::load::ply;
 use gridtrace::scene::Aabb;
 use oracles::embree::Embree;
-use oracles::rays::{bounce_rays, outside_rays, segments};
+use oracles::rays::{bounce_rays, camera_rays, outside_rays, segments};
 use oracles::{Mesh, Obvhs, dragon_path};
 use rayon::prelude::*;
 
@@ -57,25 +56,6 @@ fn summary(mut values: Vec<f64>) -> (f64, f64, f64) {
         values[0],
         values[values.len() - 1],
     )
-}
-
-/// A pinhole camera's rays: from one point framing the box, through a square image.
-fn camera_rays(bounds: &Aabb, count: usize) -> Vec<Ray> {
-    let center = bounds.center();
-    let radius = 0.5 * bounds.extent().length();
-    let eye = center + Vec3::new(0.6, 0.4, 1.0).normalize() * 2.6 * radius;
-    let forward = (center - eye).normalize();
-    let right = forward.cross(Vec3::Y).normalize();
-    let up = right.cross(forward);
-    let side = (count as f32).sqrt().ceil() as usize;
-    (0..count)
-        .map(|i| {
-            let x = ((i % side) as f32 + 0.5) / side as f32 * 2.0 - 1.0;
-            let y = ((i / side) as f32 + 0.5) / side as f32 * 2.0 - 1.0;
-            let direction = forward + 0.42 * (x * right + y * up);
-            Ray::new(eye, direction.normalize())
-        })
-        .collect()
 }
 
 type Query<'a> = Box<dyn Fn(&Ray) -> bool + 'a>;

@@ -1,4 +1,4 @@
-//! The two fixed-seed ray sets the accelerators are compared and timed on.
+//! The fixed-seed ray sets the accelerators are compared and timed on.
 
 use glam::Vec3;
 use gridtrace::accel::{Ray, Triangle};
@@ -55,5 +55,26 @@ pub fn segments(rays: &[Ray], max_length: f32, seed: u64) -> Vec<Ray> {
     let mut rng = Rng::new(seed, 3);
     rays.iter()
         .map(|r| r.with_t_max(max_length * rng.uniform().max(1e-3)))
+        .collect()
+}
+
+/// A pinhole camera's rays: from one point framing the box, through a square image. (For
+/// the benchmark and `tools/grid-ab`; the cross-check does not use them.)
+#[allow(dead_code)]
+pub fn camera_rays(bounds: &Aabb, count: usize) -> Vec<Ray> {
+    let center = bounds.center();
+    let radius = 0.5 * bounds.extent().length();
+    let eye = center + Vec3::new(0.6, 0.4, 1.0).normalize() * 2.6 * radius;
+    let forward = (center - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let side = (count as f32).sqrt().ceil() as usize;
+    (0..count)
+        .map(|i| {
+            let x = ((i % side) as f32 + 0.5) / side as f32 * 2.0 - 1.0;
+            let y = ((i / side) as f32 + 0.5) / side as f32 * 2.0 - 1.0;
+            let direction = forward + 0.42 * (x * right + y * up);
+            Ray::new(eye, direction.normalize())
+        })
         .collect()
 }
