@@ -126,13 +126,14 @@ fn counters(grid: &Grid, rays: &[Ray]) -> String {
     }
     let per_ray = |x: u64| x as f64 / rays.len() as f64;
     format!(
-        "{:.1} cells stepped ({:.1} occupied macrocells entered, {:.1} leaps over empty macrocells, {:.1} over empty cubes of cells, {:.1} plain steps), {:.1} occupied cells visited, {:.1} triangle tests, {:.2} hits per ray",
+        "{:.1} cells stepped ({:.1} occupied macrocells entered, {:.1} leaps over empty macrocells, {:.1} over empty cubes of cells, {:.1} plain steps), {:.1} occupied cells visited, {:.1} pauses of the walk ahead, {:.1} triangle tests, {:.2} hits per ray",
         per_ray(counts.cells),
         per_ray(counts.macrocell_entries),
         per_ray(counts.macrocell_leaps),
         per_ray(counts.cell_leaps),
         per_ray(counts.plain_steps),
         per_ray(counts.occupied),
+        per_ray(counts.pauses),
         per_ray(counts.tests),
         hits as f64 / rays.len() as f64
     )
