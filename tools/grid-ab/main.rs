@@ -25,7 +25,16 @@ fn main() {
     let data = std::env::var("GRID_AB_DATA").expect("set by tools/grid-ab.sh");
     let path = std::path::Path::new(&data).join(model);
     let (positions, indices) = gridtrace::load::ply::read_mesh(&path).expect("a readable mesh");
-    let new = Grid::from_mesh(positions.clone(), &indices);
+    // GRID_AB_DENSITY: this tree's grid at that many cells per triangle instead of the
+    // density it chooses (to try a density against the commit's choice).
+    let density = std::env::var("GRID_AB_DENSITY").ok().map(|s| {
+        s.parse::<f32>()
+            .expect("GRID_AB_DENSITY is a number of cells per triangle")
+    });
+    let new = match density {
+        Some(d) => Grid::from_mesh_with_density(positions.clone(), &indices, d),
+        None => Grid::from_mesh(positions.clone(), &indices),
+    };
     let base = gridtrace_base::accel::Grid::from_mesh(positions.clone(), &indices);
     println!(
         "{model}: {:?} cells; bytes this tree {}, base {}",
