@@ -11,8 +11,9 @@
 # (default 50,000); GRID_AB_DENSITY builds this tree's grid at that many cells per
 # triangle instead of the density it chooses (the base keeps its choice). Prints, per set,
 # how many answers differ (there should be none unless the change means them to) and the
-# time of this tree over the base's, median and range of the rounds. The base is copied under target/grid-ab as a crate of another name; the
-# first build takes minutes, later ones only rebuild the two copies of gridtrace.
+# time of this tree over the base's, median and range of the rounds. The base is copied
+# under target/grid-ab as a crate of another name; the first build takes minutes, later
+# ones only rebuild the two copies of gridtrace.
 set -euo pipefail
 root=$(git rev-parse --show-toplevel)
 base=${1:?usage: tools/grid-ab.sh BASE [MODEL] [SETS] [ROUNDS]}
