@@ -8,11 +8,13 @@
 //! Timing: each set is cut into chunks of 10,000 rays; for every chunk the three structures
 //! take turns (in rotating order), each keeping the best of 7 repeats, so drifts of the
 //! machine's speed touch all three alike. That is one run; the ratios are reported as the
-//! median and the range over 5 runs. Then the grid's own counters per ray, each query's
+//! median and the range over 5 runs. Then the grid's own counters per ray (for shadow
+//! segments too), where its triangle tests are made ([`tests_per_cell`]), each query's
 //! time per ray with caches cold and warm ([`cold_and_warm`]), the grid's time split
-//! between its walk and its triangles ([`Grid::walk`]), the ratio to Embree over the rays
-//! that hit the mesh and over those that miss it, each part timed alone, and the grid's
-//! speed-up on all threads.
+//! between its walk and its triangles ([`Grid::walk`]) as in the table and with caches
+//! warm (what each costs in computation alone), the ratio to Embree over the rays that hit
+//! the mesh and over those that miss it, each part timed alone, and the grid's speed-up on
+//! all threads.
 //!
 //! Run with `cargo bench --bench accel` after `tools/setup-dev.sh`. Environment:
 //! `ACCEL_BENCH_MODELS` (comma-separated files of data/dragon, default the smallest, a
@@ -24,7 +26,7 @@ mod oracles;
 
 use std::time::{Duration, Instant};
 
-use gridtrace::accel::{Grid, Ray, TraversalCounts};
+use gridtrace::accel::{Grid, Ray, TraversalCounts, TraversalStats};
 use gridtrace::load::ply;
 use gridtrace::scene::Aabb;
 use oracles::embree::Embree;
@@ -117,16 +119,21 @@ fn build_grid(mesh: &Mesh, density: Option<f32>) -> Grid {
     }
 }
 
-/// The grid's counters per ray over `rays`, as a phrase.
-fn counters(grid: &Grid, rays: &[Ray]) -> String {
+/// The grid's counters per ray over `rays` (closest-hit queries, or shadow queries if
+/// `occlusion`), as a phrase.
+fn counters(grid: &Grid, rays: &[Ray], occlusion: bool) -> String {
     let mut counts = TraversalCounts::default();
     let mut hits = 0usize;
     for r in rays {
-        hits += usize::from(grid.intersect_counting(r, &mut counts).is_some());
+        hits += usize::from(if occlusion {
+            grid.occluded_counting(r, &mut counts)
+        } else {
+            grid.intersect_counting(r, &mut counts).is_some()
+        });
     }
     let per_ray = |x: u64| x as f64 / rays.len() as f64;
     format!(
-        "{:.1} cells stepped ({:.1} occupied macrocells entered, {:.1} leaps over empty macrocells, {:.1} over empty cubes of cells, {:.1} plain steps), {:.1} occupied cells visited, {:.1} pauses of the walk ahead, {:.1} triangle tests, {:.2} hits per ray",
+        "{:.1} cells stepped ({:.1} occupied macrocells entered, {:.1} leaps over empty macrocells, {:.1} over empty cubes of cells, {:.1} plain steps), {:.1} occupied cells visited, {:.1} pauses of the walk ahead, {:.1} triangle tests, {:.2} {} per ray",
         per_ray(counts.cells),
         per_ray(counts.macrocell_entries),
         per_ray(counts.macrocell_leaps),
@@ -135,7 +142,61 @@ fn counters(grid: &Grid, rays: &[Ray]) -> String {
         per_ray(counts.occupied),
         per_ray(counts.pauses),
         per_ray(counts.tests),
-        hits as f64 / rays.len() as f64
+        hits as f64 / rays.len() as f64,
+        if occlusion { "occluded" } else { "hits" }
+    )
+}
+
+/// The triangle tests made in each occupied cell a query visits (the tests reported after
+/// the cell is given out, up to the next one).
+#[derive(Default)]
+struct TestsPerCell {
+    open: Option<u32>,
+    cells: Vec<u32>,
+}
+
+impl TraversalStats for TestsPerCell {
+    fn visit_occupied(&mut self) {
+        self.cells.extend(self.open.replace(0));
+    }
+    fn test_triangles(&mut self, count: usize) {
+        if let Some(open) = self.open.as_mut() {
+            *open += count as u32;
+        }
+    }
+}
+
+/// Where the triangle tests over `rays` are made: the share of them made in occupied cells
+/// where a ray tests more than 16, 24, 32 and 48 triangles (and those cells' share of the
+/// visits), as a phrase. Refining crowded cells can only save tests made in such cells.
+fn tests_per_cell(grid: &Grid, rays: &[Ray], occlusion: bool) -> String {
+    let mut stats = TestsPerCell::default();
+    for r in rays {
+        if occlusion {
+            grid.occluded_counting(r, &mut stats);
+        } else {
+            grid.intersect_counting(r, &mut stats);
+        }
+        stats.cells.extend(stats.open.take());
+    }
+    let tests: u64 = stats.cells.iter().map(|&n| u64::from(n)).sum();
+    let visits = stats.cells.len().max(1) as f64;
+    let shares: Vec<String> = [16, 24, 32, 48]
+        .iter()
+        .map(|&limit| {
+            let crowded = stats.cells.iter().filter(|&&n| n > limit);
+            let made: u64 = crowded.clone().map(|&n| u64::from(n)).sum();
+            format!(
+                "more than {limit}: {:.0} % of tests in {:.0} % of visits",
+                100.0 * made as f64 / tests.max(1) as f64,
+                100.0 * crowded.count() as f64 / visits
+            )
+        })
+        .collect();
+    format!(
+        "{:.1} tests per occupied cell visited; cells where a ray tests {}",
+        tests as f64 / visits,
+        shares.join(", ")
     )
 }
 
@@ -148,26 +209,38 @@ const WARM_REPEATS: usize = 8;
 /// queries in rotating order. Warm is (R·T_R − T_1)/(R − 1); cold minus warm is the time
 /// a ray waits for memory.
 fn cold_and_warm(rays: &[Ray], queries: &[Query], run: usize) -> Vec<(f64, f64)> {
-    let mut once = vec![Duration::ZERO; queries.len()];
-    let mut repeated = vec![Duration::ZERO; queries.len()];
-    for (c, chunk) in rays.chunks(CHUNK).enumerate() {
-        for k in 0..queries.len() {
-            let q = (k + c + run) % queries.len();
-            let (hits, t) = timed(|| chunk.iter().filter(|r| queries[q](r)).count());
+    cold_and_warm_of(rays.len(), queries.len(), |q, i| queries[q](&rays[i]), run)
+}
+
+/// [`cold_and_warm`] for `queries` queries over `count` rays, `query(q, i)` asking query
+/// `q` about ray `i`.
+fn cold_and_warm_of(
+    count: usize,
+    queries: usize,
+    query: impl Fn(usize, usize) -> bool,
+    run: usize,
+) -> Vec<(f64, f64)> {
+    let mut once = vec![Duration::ZERO; queries];
+    let mut repeated = vec![Duration::ZERO; queries];
+    for (c, start) in (0..count).step_by(CHUNK).enumerate() {
+        let chunk = start..(start + CHUNK).min(count);
+        for k in 0..queries {
+            let q = (k + c + run) % queries;
+            let (hits, t) = timed(|| chunk.clone().filter(|&i| query(q, i)).count());
             std::hint::black_box(hits);
             once[q] += t;
             let (hits, t) = timed(|| {
                 chunk
-                    .iter()
-                    .flat_map(|r| std::iter::repeat_n(r, WARM_REPEATS))
-                    .filter(|r| queries[q](r))
+                    .clone()
+                    .flat_map(|i| std::iter::repeat_n(i, WARM_REPEATS))
+                    .filter(|&i| query(q, i))
                     .count()
             });
             std::hint::black_box(hits);
             repeated[q] += t;
         }
     }
-    let n = rays.len() as f64;
+    let n = count as f64;
     let r = WARM_REPEATS as f64;
     once.iter()
         .zip(&repeated)
@@ -285,6 +358,16 @@ fn main() {
                 grid_t.0 - grid_t.1,
                 embree_t.0 - embree_t.1,
             ));
+            notes.push(format!(
+                "{model}, {name} rays: {}",
+                tests_per_cell(&grid, rays, *occlusion)
+            ));
+            if *occlusion {
+                notes.push(format!(
+                    "{model}, {name} rays: {}",
+                    counters(&grid, rays, true)
+                ));
+            }
             if !*occlusion {
                 let stops: Vec<f32> = rays
                     .iter()
@@ -300,7 +383,29 @@ fn main() {
                     100.0 * walk / query,
                     query - walk
                 ));
-                notes.push(format!("{model}, {name} rays: {}", counters(&grid, rays)));
+                // The same split with caches warm: what the walk and the triangles cost
+                // in computation alone.
+                let warm: Vec<Vec<(f64, f64)>> = (0..runs)
+                    .map(|run| {
+                        let query = |q: usize, i: usize| match q {
+                            0 => grid.intersect(&rays[i]).is_some(),
+                            _ => grid.walk(&rays[i], stops[i]) > 0,
+                        };
+                        cold_and_warm_of(rays.len(), 2, query, run)
+                    })
+                    .collect();
+                let (query, ..) = summary(warm.iter().map(|t| t[0].1).collect());
+                let (walk, ..) = summary(warm.iter().map(|t| t[1].1).collect());
+                notes.push(format!(
+                    "{model}, {name} rays, grid ns per ray warm (median of {runs}): query {query:.0}, of which the walk alone {walk:.0} ({:.0} %), the triangles' tests {:.0}; Embree's whole query {:.0}",
+                    100.0 * walk / query,
+                    query - walk,
+                    embree_t.1
+                ));
+                notes.push(format!(
+                    "{model}, {name} rays: {}",
+                    counters(&grid, rays, false)
+                ));
                 // Rays that hit the mesh and rays that miss it (by Embree's answer) cost
                 // the two structures very differently: each part timed on its own, grid
                 // against Embree, like the table.
@@ -320,7 +425,7 @@ fn main() {
                         "{model}, {name} rays that {part} the mesh ({} of {}): grid/Embree {ratio:.2} ({lo:.2}–{hi:.2}), ns per ray grid {g:.0}, Embree {e:.0}; {}",
                         subset.len(),
                         rays.len(),
-                        counters(&grid, subset)
+                        counters(&grid, subset, false)
                     ));
                 }
             }
