@@ -119,17 +119,28 @@ fn build_grid(mesh: &Mesh, density: Option<f32>) -> Grid {
     }
 }
 
+/// Traces `ray` through `grid` (a shadow query if `occlusion`, else a closest-hit query),
+/// reporting its work to `stats`; true when it is blocked or hits.
+fn trace_counting(
+    grid: &Grid,
+    ray: &Ray,
+    occlusion: bool,
+    stats: &mut impl TraversalStats,
+) -> bool {
+    if occlusion {
+        grid.occluded_counting(ray, stats)
+    } else {
+        grid.intersect_counting(ray, stats).is_some()
+    }
+}
+
 /// The grid's counters per ray over `rays` (closest-hit queries, or shadow queries if
 /// `occlusion`), as a phrase.
 fn counters(grid: &Grid, rays: &[Ray], occlusion: bool) -> String {
     let mut counts = TraversalCounts::default();
     let mut hits = 0usize;
     for r in rays {
-        hits += usize::from(if occlusion {
-            grid.occluded_counting(r, &mut counts)
-        } else {
-            grid.intersect_counting(r, &mut counts).is_some()
-        });
+        hits += usize::from(trace_counting(grid, r, occlusion, &mut counts));
     }
     let per_ray = |x: u64| x as f64 / rays.len() as f64;
     format!(
@@ -172,11 +183,7 @@ impl TraversalStats for TestsPerCell {
 fn tests_per_cell(grid: &Grid, rays: &[Ray], occlusion: bool) -> String {
     let mut stats = TestsPerCell::default();
     for r in rays {
-        if occlusion {
-            grid.occluded_counting(r, &mut stats);
-        } else {
-            grid.intersect_counting(r, &mut stats);
-        }
+        trace_counting(grid, r, occlusion, &mut stats);
         stats.cells.extend(stats.open.take());
     }
     let tests: u64 = stats.cells.iter().map(|&n| u64::from(n)).sum();
