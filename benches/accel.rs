@@ -13,8 +13,8 @@
 //! time per ray with caches cold and warm ([`cold_and_warm`]), the grid's time split
 //! between its walk and its triangles ([`Grid::walk`]) as in the table and with caches
 //! warm (what each costs in computation alone), the ratio to Embree over the rays that hit
-//! the mesh and over those that miss it, each part timed alone, and the grid's speed-up on
-//! all threads.
+//! the mesh and over those that miss it (the shadow segments that are blocked and those
+//! that pass), each part timed alone, and the grid's speed-up on all threads.
 //!
 //! Run with `cargo bench --bench accel` after `tools/setup-dev.sh`. Environment:
 //! `ACCEL_BENCH_MODELS` (comma-separated files of data/dragon, default the smallest, a
@@ -413,28 +413,39 @@ fn main() {
                     "{model}, {name} rays: {}",
                     counters(&grid, rays, false)
                 ));
-                // Rays that hit the mesh and rays that miss it (by Embree's answer) cost
-                // the two structures very differently: each part timed on its own, grid
-                // against Embree, like the table.
-                let (hit, miss): (Vec<Ray>, Vec<Ray>) =
-                    rays.iter().partition(|r| embree.intersect(r).is_some());
-                for (part, subset) in [("hit", &hit), ("miss", &miss)] {
-                    if subset.is_empty() {
-                        continue;
-                    }
-                    let rates: Vec<Vec<f64>> = (0..runs)
-                        .map(|run| run_once(subset, &queries[..2], run))
-                        .collect();
-                    let (ratio, lo, hi) = summary(rates.iter().map(|r| r[0] / r[1]).collect());
-                    let (g, ..) = summary(rates.iter().map(|r| 1e3 / r[0]).collect());
-                    let (e, ..) = summary(rates.iter().map(|r| 1e3 / r[1]).collect());
-                    notes.push(format!(
-                        "{model}, {name} rays that {part} the mesh ({} of {}): grid/Embree {ratio:.2} ({lo:.2}–{hi:.2}), ns per ray grid {g:.0}, Embree {e:.0}; {}",
-                        subset.len(),
-                        rays.len(),
-                        counters(&grid, subset, false)
-                    ));
+            }
+            // Rays that hit the mesh and rays that miss it (shadow segments that are
+            // blocked and those that are not), by Embree's answer, cost the two
+            // structures very differently: each part timed on its own, grid against
+            // Embree, like the table.
+            let (hit, miss): (Vec<Ray>, Vec<Ray>) = rays.iter().partition(|r| {
+                if *occlusion {
+                    embree.occluded(r)
+                } else {
+                    embree.intersect(r).is_some()
                 }
+            });
+            let parts = if *occlusion {
+                [("are blocked by", &hit), ("pass", &miss)]
+            } else {
+                [("hit", &hit), ("miss", &miss)]
+            };
+            for (part, subset) in parts {
+                if subset.is_empty() {
+                    continue;
+                }
+                let rates: Vec<Vec<f64>> = (0..runs)
+                    .map(|run| run_once(subset, &queries[..2], run))
+                    .collect();
+                let (ratio, lo, hi) = summary(rates.iter().map(|r| r[0] / r[1]).collect());
+                let (g, ..) = summary(rates.iter().map(|r| 1e3 / r[0]).collect());
+                let (e, ..) = summary(rates.iter().map(|r| 1e3 / r[1]).collect());
+                notes.push(format!(
+                    "{model}, {name} rays that {part} the mesh ({} of {}): grid/Embree {ratio:.2} ({lo:.2}–{hi:.2}), ns per ray grid {g:.0}, Embree {e:.0}; {}",
+                    subset.len(),
+                    rays.len(),
+                    counters(&grid, subset, *occlusion)
+                ));
             }
         }
         // Scaling of the grid over all threads, best of 3.
