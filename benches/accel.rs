@@ -369,12 +369,6 @@ fn main() {
                 "{model}, {name} rays: {}",
                 tests_per_cell(&grid, rays, *occlusion)
             ));
-            if *occlusion {
-                notes.push(format!(
-                    "{model}, {name} rays: {}",
-                    counters(&grid, rays, true)
-                ));
-            }
             if !*occlusion {
                 let stops: Vec<f32> = rays
                     .iter()
@@ -409,11 +403,11 @@ fn main() {
                     query - walk,
                     embree_t.1
                 ));
-                notes.push(format!(
-                    "{model}, {name} rays: {}",
-                    counters(&grid, rays, false)
-                ));
             }
+            notes.push(format!(
+                "{model}, {name} rays: {}",
+                counters(&grid, rays, *occlusion)
+            ));
             // Rays that hit the mesh and rays that miss it (shadow segments that are
             // blocked and those that are not), by Embree's answer, cost the two
             // structures very differently: each part timed on its own, grid against
