@@ -212,8 +212,15 @@ impl SceneAccel {
         match (&self.instance_grid, &self.list_bounds) {
             (None, Some(bounds)) => {
                 let slabs = bounds.slabs(ray, inv_direction);
-                for e in 0..self.entries.len() {
+                for _ in &self.entries {
                     stats.test_instance();
+                }
+                // Only the entries whose bounds the ray meets, in order.
+                let mut met = slabs.met();
+                while met != 0 {
+                    let e = met.trailing_zeros() as usize;
+                    met &= met - 1;
+                    // A hit found since may have brought the end before this entry.
                     if !slabs.hits(e, t_max) {
                         continue;
                     }
@@ -265,14 +272,20 @@ impl SceneAccel {
         match (&self.instance_grid, &self.list_bounds) {
             (None, Some(bounds)) => {
                 let slabs = bounds.slabs(ray, inv_direction);
-                (0..self.entries.len()).any(|e| {
+                for _ in &self.entries {
                     stats.test_instance();
-                    let entry = &self.entries[e];
-                    slabs.hits(e, ray.t_max)
-                        && entry.in_grid_space(ray).is_some_and(|local| {
-                            self.grids[entry.grid].occluded_counting(&local, stats)
-                        })
-                })
+                }
+                let mut met = slabs.met();
+                while met != 0 {
+                    let entry = &self.entries[met.trailing_zeros() as usize];
+                    met &= met - 1;
+                    if entry.in_grid_space(ray).is_some_and(|local| {
+                        self.grids[entry.grid].occluded_counting(&local, stats)
+                    }) {
+                        return true;
+                    }
+                }
+                false
             }
             (None, None) => {
                 (0..self.entries.len()).any(|e| self.occluded_by(e, ray, inv_direction, stats))
