@@ -59,11 +59,13 @@ fn lesser(a: f32, b: f32) -> f32 {
 
 /// One axis of the slab test: the entry and exit so far (`start`, `end`) narrowed by the
 /// slab between `lo` and `hi` along that axis, for an origin coordinate `o` and reciprocal
-/// direction `d`. A NaN distance (0·∞: the ray parallel to the slab and on one of its
-/// planes) is passed over by `f32::min` and `max`. (Single `minps`/`maxps`, which pass on
-/// a NaN in one operand, were measured: fewer instructions, yet the renders of the
-/// Principled test scenes took 1.06–1.14× as long.) The lanes and [`hits_box`] share
-/// this, so they agree on every ray.
+/// direction `d`. The exit is widened by its rounding error, so a ray through the box is
+/// never culled by rounding (pbrt-v4 §6.8.2: t_far·(1 + 2γ(3))). A NaN distance (0·∞: the
+/// ray parallel to the slab and on one of its planes) is passed over by `f32::min` and
+/// `max`. (Single `minps`/`maxps`, which pass on a NaN in one operand, were measured:
+/// fewer instructions, yet the renders of the Principled test scenes took 1.06–1.16× as
+/// long; docs/grid.md, "Sixteenth session".) The lanes and [`hits_box`] share this, so
+/// they agree on every ray.
 #[inline(always)]
 fn narrow(start: f32, end: f32, lo: f32, hi: f32, o: f32, d: f32) -> (f32, f32) {
     let t0 = (lo - o) * d;
