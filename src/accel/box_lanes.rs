@@ -43,8 +43,8 @@ impl Slabs {
 
     /// The boxes the ray meets before its `t_max`, as bits (box `i` in bit `i`), so that a
     /// query visits only those instead of asking each box in turn. (Found with the slabs,
-    /// in the same vector lanes: read back from memory lane by lane, the mask's
-    /// misaligned loads of the slabs just stored cost more than the slab test.)
+    /// from the lanes still in registers, rather than by loading back the slabs just
+    /// stored.)
     #[inline]
     pub fn met(&self) -> u32 {
         self.met
