@@ -95,7 +95,10 @@ impl BoxLanes {
     }
 
     /// The ray against every box (`inv` is its direction's reciprocal).
-    #[inline]
+    /// Always inlined, so that it is compiled with the caller's instruction set (the top
+    /// level's queries have versions compiled for AVX2, where a group is one vector) and
+    /// its lanes stay in registers.
+    #[inline(always)]
     pub fn slabs(&self, ray: &Ray, inv: Vec3) -> Slabs {
         let mut start = [ray.t_min; LANES];
         let mut end = [f32::INFINITY; LANES];

@@ -3,6 +3,7 @@
 
 mod box_lanes;
 mod cell_lanes;
+mod cpu;
 mod frame;
 pub mod grid;
 mod huge_pages;
