@@ -56,7 +56,7 @@ impl GridFrame {
     }
 
     /// The cell holding point `p`, clamped into the grid.
-    #[inline]
+    #[inline(always)]
     pub fn cell_of(&self, p: Vec3) -> UVec3 {
         let c = ((p - self.bounds.min) * self.inv_cell_size).floor();
         c.max(Vec3::ZERO).as_uvec3().min(self.resolution - 1)
@@ -64,6 +64,7 @@ impl GridFrame {
 
     /// How far cells are grown when deciding what they hold, so that rounding never drops
     /// a cell something touches: whatever lies on a cell face belongs to both sides.
+    #[inline(always)]
     pub fn pad(&self) -> Vec3 {
         let magnitude = self
             .bounds
@@ -75,6 +76,7 @@ impl GridFrame {
     }
 
     /// The cells (inclusive corners) a box touches, cells grown by [`GridFrame::pad`].
+    #[inline(always)]
     pub fn cells_of_box(&self, b: &Aabb) -> (UVec3, UVec3) {
         let pad = self.pad();
         (self.cell_of(b.min - pad), self.cell_of(b.max + pad))

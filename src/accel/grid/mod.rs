@@ -15,6 +15,7 @@
 mod block;
 mod box_counts;
 mod build;
+mod cell_order;
 mod cell_reach;
 mod cells;
 pub mod density;

@@ -41,6 +41,7 @@ const AXES: usize = 12;
 
 impl TriangleBoxTest {
     /// Prepares triangle `v` for boxes of half-size `half`.
+    #[inline(always)]
     pub fn new(v: [Vec3; 3], half: Vec3) -> TriangleBoxTest {
         let origin = v[0];
         let v = v.map(|p| p - origin);
@@ -78,7 +79,7 @@ impl TriangleBoxTest {
     /// True when the triangle overlaps the box centred at `center` (Akenine-Möller 2001:
     /// no separating axis among the box's three, the triangle's normal and the nine cross
     /// products). Touching counts as overlapping.
-    #[inline]
+    #[inline(always)]
     pub fn overlaps(&self, center: Vec3) -> bool {
         let c = center - self.origin;
         // The box's own axes: compare bounding intervals.
