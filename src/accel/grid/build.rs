@@ -6,6 +6,7 @@ use rayon::prelude::*;
 use super::block::{Block, LANES};
 use super::cell_order::{Buckets, CellOrder, KeyParts};
 use super::cells::{CellIndex, MACRO_CELLS};
+use super::mesh_triangles::MeshTriangles;
 use super::overlap::{Polygon, TriangleBoxTest};
 use super::{Grid, density};
 #[cfg(target_arch = "x86_64")]
@@ -49,40 +50,23 @@ impl Grid {
 
     /// [`Grid::from_mesh_with_density`], the density chosen for the mesh when `None`.
     fn build_mesh(vertices: Vec<Vec3>, indices: &[[u32; 3]], density: Option<f32>) -> Grid {
-        let triangle = |t: &[u32; 3]| {
-            t.iter()
-                .all(|&i| (i as usize) < vertices.len())
-                .then(|| {
-                    Triangle::new(
-                        vertices[t[0] as usize],
-                        vertices[t[1] as usize],
-                        vertices[t[2] as usize],
-                    )
-                })
-                .filter(|tri| !tri.is_degenerate())
-        };
-        // In parallel; the results are the same on any thread count (an ordered collect,
-        // and bounds are exact minima and maxima).
-        let mut triangles: Vec<Option<Triangle>> = huge_pages::vec_with_capacity(indices.len());
-        indices
-            .par_iter()
-            .map(triangle)
-            .collect_into_vec(&mut triangles);
+        let triangles = MeshTriangles::new(&vertices, indices);
         // The live triangles' numbers, bounds and summed sizes, chunk by chunk, joined in
-        // order (so the sums are the same on any thread count).
+        // order (so the sums are the same on any thread count; bounds are exact minima and
+        // maxima).
         const CHUNK: usize = 16384;
-        let parts: Vec<(Vec<u32>, Aabb, Sizes)> = triangles
-            .par_chunks(CHUNK)
-            .enumerate()
-            .map(|(c, chunk)| {
-                let mut live = Vec::with_capacity(chunk.len());
+        let parts: Vec<(Vec<u32>, Aabb, Sizes)> = (0..indices.len().div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let range = c * CHUNK..((c + 1) * CHUNK).min(indices.len());
+                let mut live = Vec::with_capacity(range.len());
                 let mut bounds = Aabb::EMPTY;
                 let mut sizes = Sizes::default();
-                for (i, t) in chunk.iter().enumerate() {
-                    if let Some(t) = t {
-                        live.push((c * CHUNK + i) as u32);
-                        bounds = bounds.union(t.bounds());
-                        sizes.add(&Sizes::of(t));
+                for t in range {
+                    if let Some(triangle) = triangles.live(t) {
+                        live.push(t as u32);
+                        bounds = bounds.union(triangle.bounds());
+                        sizes.add(&Sizes::of(&triangle));
                     }
                 }
                 (live, bounds, sizes)
@@ -109,12 +93,12 @@ impl Grid {
                 UVec3::ONE
             } else {
                 let density =
-                    density.unwrap_or_else(|| density::density_for(bounds, &triangles, &live));
+                    density.unwrap_or_else(|| density::density_for(bounds, triangles, &live));
                 resolution(bounds.extent(), live.len(), density)
             };
             (
                 bounds,
-                within_reference_budget(wanted, bounds, &triangles, &sizes),
+                within_reference_budget(wanted, bounds, triangles, &live, &sizes),
             )
         };
         let mut grid = Grid {
@@ -127,7 +111,7 @@ impl Grid {
         };
         // The estimate above keeps references far below 2^32; should it ever be wrong,
         // halve the resolution rather than overflow the 32-bit offsets.
-        while !grid.insert(&triangles, &live) {
+        while !grid.insert(triangles, &live) {
             grid.frame = GridFrame::new(
                 grid.frame.bounds,
                 (grid.frame.resolution / 2).max(UVec3::ONE),
@@ -144,7 +128,7 @@ impl Grid {
     /// Within a cell, triangles keep mesh order whatever the thread count, so ties between
     /// equal hits resolve the same way. False, with nothing changed, if there are more
     /// references than 32-bit offsets hold.
-    fn insert(&mut self, triangles: &[Option<Triangle>], live: &[u32]) -> bool {
+    fn insert(&mut self, triangles: MeshTriangles, live: &[u32]) -> bool {
         let m = CellIndex::macro_resolution_for(self.frame.resolution);
         let keys = (m.x * m.y * m.z) as usize * MACRO_CELLS;
         let parts = KeyParts::new(keys);
@@ -187,7 +171,7 @@ impl Grid {
                 let mut block = Block::EMPTY;
                 let run = &sorted[start as usize..(start + length) as usize];
                 for (lane, &t) in run.iter().enumerate() {
-                    block.set(lane, &triangles[t as usize].unwrap(), t);
+                    block.set(lane, &triangles.get(t), t);
                 }
                 block
             })
@@ -200,7 +184,7 @@ impl Grid {
 
     /// The (cell, triangle) pairs of the live triangles numbered in `chunk`, in triangle
     /// order, in the buckets of `parts`.
-    fn pairs_of(&self, chunk: &[u32], triangles: &[Option<Triangle>], parts: &KeyParts) -> Buckets {
+    fn pairs_of(&self, chunk: &[u32], triangles: MeshTriangles, parts: &KeyParts) -> Buckets {
         #[cfg(target_arch = "x86_64")]
         if x86_fast_path() {
             // SAFETY: the processor has the features enabled there, checked just above.
@@ -214,12 +198,7 @@ impl Grid {
     /// function). The arithmetic, and so the grid, is the same.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
-    fn pairs_of_avx2(
-        &self,
-        chunk: &[u32],
-        triangles: &[Option<Triangle>],
-        parts: &KeyParts,
-    ) -> Buckets {
+    fn pairs_of_avx2(&self, chunk: &[u32], triangles: MeshTriangles, parts: &KeyParts) -> Buckets {
         self.pairs_of_portable(chunk, triangles, parts)
     }
 
@@ -227,12 +206,12 @@ impl Grid {
     fn pairs_of_portable(
         &self,
         chunk: &[u32],
-        triangles: &[Option<Triangle>],
+        triangles: MeshTriangles,
         parts: &KeyParts,
     ) -> Buckets {
         let mut buckets = parts.buckets();
         for &t in chunk {
-            self.for_each_overlapped_cell(&triangles[t as usize].unwrap(), |cell| {
+            self.for_each_overlapped_cell(&triangles.get(t), |cell| {
                 parts.push(&mut buckets, cell, t)
             });
         }
@@ -316,7 +295,7 @@ impl Grid {
 }
 
 /// The vertices and indices of a triangle soup, three corners per triangle.
-fn soup(triangles: &[Triangle]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+pub(super) fn soup(triangles: &[Triangle]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let vertices = triangles.iter().flat_map(|t| t.vertices()).collect();
     let indices = (0..triangles.len() as u32)
         .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
@@ -333,13 +312,14 @@ const MAX_REFERENCES: f64 = (1u64 << 31) as f64;
 /// `wanted`, made coarser until the estimated references fit the budget. A triangle of
 /// area A and perimeter P overlaps about √3·A/s² + 2·P/s + 1 cells of side s (the cells its
 /// surface and its edges pass through), and never more than its bounding box holds.
-/// The live ones of `triangles` (the others, `None`, make no references) add up to `sizes`:
-/// while the estimate without the bounding-box limit fits (the usual case), no pass over the
-/// triangles is needed.
+/// The live triangles (numbered in `live`; the others make no references) add up to
+/// `sizes`: while the estimate without the bounding-box limit fits (the usual case), no pass
+/// over the triangles is needed.
 fn within_reference_budget(
     wanted: UVec3,
     bounds: Aabb,
-    triangles: &[Option<Triangle>],
+    triangles: MeshTriangles,
+    live: &[u32],
     sizes: &Sizes,
 ) -> UVec3 {
     let budget = reference_budget(sizes.count);
@@ -353,9 +333,9 @@ fn within_reference_budget(
         let estimate_of = |t: &Triangle| estimated_cells(t, cell);
         // Partial sums over fixed chunks, added in order: the same total on any number of
         // threads, so the same grid.
-        let partial: Vec<f64> = triangles
+        let partial: Vec<f64> = live
             .par_chunks(4096)
-            .map(|chunk| chunk.iter().flatten().map(estimate_of).sum())
+            .map(|chunk| chunk.iter().map(|&t| estimate_of(&triangles.get(t))).sum())
             .collect();
         let estimate: f64 = partial.iter().sum();
         if estimate <= budget || r == UVec3::ONE {
@@ -416,12 +396,20 @@ impl Sizes {
 mod tests {
     use super::*;
 
-    fn sizes_of(triangles: &[Option<Triangle>]) -> Sizes {
+    fn sizes_of(triangles: &[Triangle]) -> Sizes {
         let mut sizes = Sizes::default();
-        for t in triangles.iter().flatten() {
+        for t in triangles {
             sizes.add(&Sizes::of(t));
         }
         sizes
+    }
+
+    /// The reference budget's choice for `triangles` (as an indexed mesh, all live).
+    fn budgeted(wanted: UVec3, bounds: Aabb, triangles: &[Triangle]) -> UVec3 {
+        let (vertices, indices) = soup(triangles);
+        let live: Vec<u32> = (0..triangles.len() as u32).collect();
+        let mesh = MeshTriangles::new(&vertices, &indices);
+        within_reference_budget(wanted, bounds, mesh, &live, &sizes_of(triangles))
     }
 
     /// The overlap tests compiled for this processor pair each triangle with exactly the
@@ -430,26 +418,28 @@ mod tests {
     #[test]
     fn the_portable_overlap_tests_find_what_the_fast_ones_find() {
         let mut rng = crate::render::sampling::Rng::new(41, 5);
-        let triangles: Vec<Option<Triangle>> = (0..6_000)
+        let triangles: Vec<Triangle> = (0..6_000)
             .map(|k| {
                 let mut u = || rng.uniform() * 2.0 - 1.0;
                 let size = [0.002, 0.02, 0.3, 1.5][k % 4];
                 let a = Vec3::new(u(), u(), u());
-                Some(Triangle::new(
+                Triangle::new(
                     a,
                     a + Vec3::new(u(), u(), u()) * size,
                     a + Vec3::new(u(), u(), u()) * size,
-                ))
+                )
             })
             .collect();
-        let grid = Grid::build(triangles.iter().flatten().copied().collect());
+        let grid = Grid::build(triangles.clone());
+        let (vertices, indices) = soup(&triangles);
+        let mesh = MeshTriangles::new(&vertices, &indices);
         let live: Vec<u32> = (0..triangles.len() as u32).collect();
         let m = CellIndex::macro_resolution_for(grid.frame.resolution);
         let parts = KeyParts::new((m.x * m.y * m.z) as usize * MACRO_CELLS);
         let mut pairs = 0;
         for chunk in live.chunks(500) {
-            let fast = grid.pairs_of(chunk, &triangles, &parts);
-            assert_eq!(fast, grid.pairs_of_portable(chunk, &triangles, &parts));
+            let fast = grid.pairs_of(chunk, mesh, &parts);
+            assert_eq!(fast, grid.pairs_of_portable(chunk, mesh, &parts));
             pairs += fast.iter().map(Vec::len).sum::<usize>();
         }
         assert!(pairs > 3 * triangles.len(), "{pairs} pairs");
@@ -464,33 +454,29 @@ mod tests {
             max: Vec3::splat(1.0),
         };
         let wanted = UVec3::splat(200);
-        let small: Vec<Option<Triangle>> = (0..2000)
+        let small: Vec<Triangle> = (0..2000)
             .map(|i| {
                 let p = Vec3::new((i % 13) as f32, (i % 7) as f32, (i % 11) as f32) / 13.0;
-                Some(Triangle::new(p, p + Vec3::X * 0.01, p + Vec3::Y * 0.01))
+                Triangle::new(p, p + Vec3::X * 0.01, p + Vec3::Y * 0.01)
             })
             .collect();
-        let r = within_reference_budget(wanted, bounds, &small, &sizes_of(&small));
+        let r = budgeted(wanted, bounds, &small);
         assert_eq!(r, wanted);
-        let slivers: Vec<Option<Triangle>> = (0..2000)
+        let slivers: Vec<Triangle> = (0..2000)
             .map(|i| {
                 let y = i as f32 / 2000.0;
-                Some(Triangle::new(
+                Triangle::new(
                     Vec3::new(0.0, y, 0.0),
                     Vec3::new(1.0, y, 1.0),
                     Vec3::new(1.0, y + 1e-4, 1.0),
-                ))
+                )
             })
             .collect();
-        let r = within_reference_budget(wanted, bounds, &slivers, &sizes_of(&slivers));
+        let r = budgeted(wanted, bounds, &slivers);
         assert!(r.x < wanted.x && r.x > 1, "{r}");
         // What was chosen fits the budget by the clamped per-triangle estimate.
         let cell = bounds.extent() / r.as_vec3();
-        let estimate: f64 = slivers
-            .iter()
-            .flatten()
-            .map(|t| estimated_cells(t, cell))
-            .sum();
+        let estimate: f64 = slivers.iter().map(|t| estimated_cells(t, cell)).sum();
         assert!(estimate <= reference_budget(2000.0));
     }
 }

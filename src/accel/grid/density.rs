@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use rayon::prelude::*;
 
-use crate::accel::Triangle;
+use super::mesh_triangles::MeshTriangles;
 use crate::accel::frame::{GridFrame, resolution};
 use crate::scene::Aabb;
 
@@ -38,7 +38,7 @@ pub const UNEVEN_DENSITY: f32 = 5.0;
 pub const EVEN_CROWDING: f64 = 16.0;
 
 /// The density for the live triangles of `triangles` (numbered in `live`) in `bounds`.
-pub(super) fn density_for(bounds: Aabb, triangles: &[Option<Triangle>], live: &[u32]) -> f32 {
+pub(super) fn density_for(bounds: Aabb, triangles: MeshTriangles, live: &[u32]) -> f32 {
     let crowding = crowding(bounds, triangles, live);
     if crowding <= EVEN_CROWDING {
         return EVEN_DENSITY;
@@ -49,7 +49,7 @@ pub(super) fn density_for(bounds: Aabb, triangles: &[Option<Triangle>], live: &[
 
 /// Σ n² / Σ n over the cells of a grid of [`EVEN_DENSITY`] over `bounds`, n the number of
 /// triangle centroids in a cell: the centroid count of an average triangle's cell.
-pub(super) fn crowding(bounds: Aabb, triangles: &[Option<Triangle>], live: &[u32]) -> f64 {
+pub(super) fn crowding(bounds: Aabb, triangles: MeshTriangles, live: &[u32]) -> f64 {
     if live.is_empty() {
         return 0.0;
     }
@@ -59,9 +59,7 @@ pub(super) fn crowding(bounds: Aabb, triangles: &[Option<Triangle>], live: &[u32
     );
     let counts: Vec<AtomicU32> = (0..frame.cell_count()).map(|_| AtomicU32::new(0)).collect();
     live.par_iter().for_each(|&t| {
-        let Some(triangle) = &triangles[t as usize] else {
-            return;
-        };
+        let triangle = triangles.get(t);
         let centroid = triangle.v0 + (triangle.e1 + triangle.e2) / 3.0;
         let cell = frame.cell_index(frame.cell_of(centroid));
         counts[cell].fetch_add(1, Ordering::Relaxed);
@@ -81,21 +79,23 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
+    use crate::accel::Triangle;
+    use crate::accel::grid::build::soup;
 
-    fn live(triangles: &[Option<Triangle>]) -> Vec<u32> {
-        (0..triangles.len() as u32).collect()
-    }
-
-    fn bounds(triangles: &[Option<Triangle>]) -> Aabb {
-        triangles
+    /// `f` of the triangles' bounds, the triangles as an indexed mesh, and their numbers
+    /// (every one live).
+    fn on_mesh<T>(triangles: &[Triangle], f: impl FnOnce(Aabb, MeshTriangles, &[u32]) -> T) -> T {
+        let (vertices, indices) = soup(triangles);
+        let live: Vec<u32> = (0..triangles.len() as u32).collect();
+        let bounds = triangles
             .iter()
-            .flatten()
-            .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()))
+            .fold(Aabb::EMPTY, |b, t| b.union(t.bounds()));
+        f(bounds, MeshTriangles::new(&vertices, &indices), &live)
     }
 
     /// The surface of the cube [−1, 1]³, each face cut into `n` × `n` squares split in two:
     /// triangles of one size, evenly spread.
-    fn cube_surface(n: usize) -> Vec<Option<Triangle>> {
+    fn cube_surface(n: usize) -> Vec<Triangle> {
         let mut triangles = Vec::new();
         for axis in 0..3 {
             for side in [-1.0f32, 1.0] {
@@ -113,8 +113,8 @@ mod tests {
                 for i in 0..n {
                     for j in 0..n {
                         let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-                        triangles.push(Some(Triangle::new(a, b, c)));
-                        triangles.push(Some(Triangle::new(a, c, d)));
+                        triangles.push(Triangle::new(a, b, c));
+                        triangles.push(Triangle::new(a, c, d));
                     }
                 }
             }
@@ -127,24 +127,22 @@ mod tests {
     #[test]
     fn crowded_meshes_get_finer_cells() {
         let surface = cube_surface(60);
-        let b = bounds(&surface);
-        assert_eq!(density_for(b, &surface, &live(&surface)), EVEN_DENSITY);
+        assert_eq!(on_mesh(&surface, density_for), EVEN_DENSITY);
         let mut on_floor = surface.clone();
         let corner = |x: f32, z: f32| Vec3::new(x, -1.0, z);
-        on_floor.push(Some(Triangle::new(
+        on_floor.push(Triangle::new(
             corner(-100.0, -100.0),
             corner(100.0, -100.0),
             corner(100.0, 100.0),
-        )));
-        on_floor.push(Some(Triangle::new(
+        ));
+        on_floor.push(Triangle::new(
             corner(-100.0, -100.0),
             corner(100.0, 100.0),
             corner(-100.0, 100.0),
-        )));
-        let b = bounds(&on_floor);
-        let crowded = crowding(b, &on_floor, &live(&on_floor));
+        ));
+        let crowded = on_mesh(&on_floor, crowding);
         assert!(crowded > 4.0 * EVEN_CROWDING, "{crowded}");
-        assert_eq!(density_for(b, &on_floor, &live(&on_floor)), UNEVEN_DENSITY);
+        assert_eq!(on_mesh(&on_floor, density_for), UNEVEN_DENSITY);
     }
 
     /// Between the two, the density never falls as the floor grows, and ends above the
@@ -155,13 +153,12 @@ mod tests {
         for floor in [1.0f32, 2.0, 3.0, 4.0, 6.0, 10.0] {
             let mut mesh = cube_surface(40);
             let corner = |x: f32, z: f32| Vec3::new(x * floor, -1.0, z * floor);
-            mesh.push(Some(Triangle::new(
+            mesh.push(Triangle::new(
                 corner(-1.0, -1.0),
                 corner(1.0, -1.0),
                 corner(1.0, 1.0),
-            )));
-            let b = bounds(&mesh);
-            let density = density_for(b, &mesh, &live(&mesh));
+            ));
+            let density = on_mesh(&mesh, density_for);
             assert!(
                 (EVEN_DENSITY..=UNEVEN_DENSITY).contains(&density),
                 "{density}"

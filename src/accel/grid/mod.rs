@@ -19,6 +19,7 @@ mod cell_order;
 mod cell_reach;
 mod cells;
 pub mod density;
+mod mesh_triangles;
 mod overlap;
 mod reach;
 mod traverse;
