@@ -15,7 +15,7 @@ use super::reach;
 use super::{Grid, GridHit};
 use crate::accel::Ray;
 #[cfg(target_arch = "x86_64")]
-use crate::accel::cpu::x86_fast_path;
+use crate::accel::cpu::{X86Level, x86_level};
 use crate::accel::frame::CellWalk;
 use crate::accel::prefetch::prefetch;
 
@@ -111,10 +111,13 @@ impl Grid {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
+        // SAFETY (each arm): the processor has the features enabled in the version called,
+        // as `x86_level` found.
         #[cfg(target_arch = "x86_64")]
-        if x86_fast_path() {
-            // SAFETY: the processor has the features enabled there, checked just above.
-            return unsafe { self.intersect_avx2(ray, stats) };
+        match x86_level() {
+            X86Level::Avx512 => return unsafe { self.intersect_avx512(ray, stats) },
+            X86Level::Avx2 => return unsafe { self.intersect_avx2(ray, stats) },
+            X86Level::Baseline => {}
         }
         self.intersect_portable(ray, stats)
     }
@@ -124,6 +127,14 @@ impl Grid {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
     fn intersect_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
+        self.intersect_portable(ray, stats)
+    }
+
+    /// [`Grid::intersect_portable`] compiled for AVX-512 ([`X86Level::Avx512`]; the same
+    /// arithmetic).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
+    fn intersect_avx512(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
         self.intersect_portable(ray, stats)
     }
 
@@ -155,10 +166,12 @@ impl Grid {
     /// cells given out. For the benchmark, to split a query's time between the walk and the
     /// triangles.
     pub fn walk(&self, ray: &Ray, t_stop: f32) -> usize {
+        // SAFETY (each arm): as in `intersect_counting`.
         #[cfg(target_arch = "x86_64")]
-        if x86_fast_path() {
-            // SAFETY: the processor has the features enabled there, checked just above.
-            return unsafe { self.walk_avx2(ray, t_stop) };
+        match x86_level() {
+            X86Level::Avx512 => return unsafe { self.walk_avx512(ray, t_stop) },
+            X86Level::Avx2 => return unsafe { self.walk_avx2(ray, t_stop) },
+            X86Level::Baseline => {}
         }
         self.walk_portable(ray, t_stop)
     }
@@ -167,6 +180,13 @@ impl Grid {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
     fn walk_avx2(&self, ray: &Ray, t_stop: f32) -> usize {
+        self.walk_portable(ray, t_stop)
+    }
+
+    /// [`Grid::walk_portable`] compiled for AVX-512, like the queries.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
+    fn walk_avx512(&self, ray: &Ray, t_stop: f32) -> usize {
         self.walk_portable(ray, t_stop)
     }
 
@@ -190,10 +210,12 @@ impl Grid {
 
     /// [`Grid::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        // SAFETY (each arm): as in `intersect_counting`.
         #[cfg(target_arch = "x86_64")]
-        if x86_fast_path() {
-            // SAFETY: the processor has the features enabled there, checked just above.
-            return unsafe { self.occluded_avx2(ray, stats) };
+        match x86_level() {
+            X86Level::Avx512 => return unsafe { self.occluded_avx512(ray, stats) },
+            X86Level::Avx2 => return unsafe { self.occluded_avx2(ray, stats) },
+            X86Level::Baseline => {}
         }
         self.occluded_portable(ray, stats)
     }
@@ -202,6 +224,13 @@ impl Grid {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
     fn occluded_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        self.occluded_portable(ray, stats)
+    }
+
+    /// [`Grid::occluded_portable`] compiled for AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
+    fn occluded_avx512(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         self.occluded_portable(ray, stats)
     }
 
@@ -512,9 +541,9 @@ mod tests {
         );
     }
 
-    /// The portable query (compiled for baseline x86-64 here) finds what the query
-    /// compiled for this processor finds: the same nearest hit for every ray, and the same
-    /// shadow answers.
+    /// The portable query (compiled for baseline x86-64 here) finds what the queries
+    /// compiled for this processor find (AVX-512 and AVX2, where it has them): the same
+    /// nearest hit for every ray, and the same shadow answers.
     #[test]
     fn the_portable_walk_finds_what_the_fast_one_finds() {
         let grid = Grid::build(sphere(90));
@@ -526,18 +555,25 @@ mod tests {
             let direction = Vec3::new(u(), u(), u()).normalize();
             let mut ray = Ray::new(origin, direction);
             let fast = grid.intersect(&ray);
-            assert_eq!(
-                fast,
-                grid.intersect_portable(&ray, &mut ()),
-                "ray {k}: {ray:?}"
-            );
+            let portable = grid.intersect_portable(&ray, &mut ());
+            assert_eq!(fast, portable, "ray {k}: {ray:?}");
+            // On a processor with AVX-512, the AVX2 version too.
+            #[cfg(target_arch = "x86_64")]
+            if x86_level() >= X86Level::Avx2 {
+                // SAFETY: the processor has AVX2 and the rest, as `x86_level` found.
+                let avx2 = unsafe { grid.intersect_avx2(&ray, &mut ()) };
+                assert_eq!(avx2, portable, "ray {k}: {ray:?}");
+            }
             hits += usize::from(fast.is_some());
             ray.t_max = 1.5;
-            assert_eq!(
-                grid.occluded(&ray),
-                grid.occluded_portable(&ray, &mut ()),
-                "ray {k}: {ray:?}"
-            );
+            let blocked = grid.occluded_portable(&ray, &mut ());
+            assert_eq!(grid.occluded(&ray), blocked, "ray {k}: {ray:?}");
+            #[cfg(target_arch = "x86_64")]
+            if x86_level() >= X86Level::Avx2 {
+                // SAFETY: as above.
+                let avx2 = unsafe { grid.occluded_avx2(&ray, &mut ()) };
+                assert_eq!(avx2, blocked, "ray {k}: {ray:?}");
+            }
         }
         assert!(hits > 5_000, "{hits} hits");
     }
