@@ -208,9 +208,10 @@ pub(crate) struct CellWalk {
 }
 
 impl CellWalk {
-    /// Moves the walk out of the empty cube of `side` units of `2^unit_shift` cells a side
-    /// (units aligned to multiples of their size) that has the current cell's unit as its
-    /// corner and extends in the ray's direction, to the first cell beyond it along the ray;
+    /// Moves the walk out of the empty cube of `side` cells a side (`side` ≥ `2^unit_shift`)
+    /// that has the current cell's unit of `2^unit_shift` cells a side (units aligned to
+    /// multiples of their size) in its corner and extends in the ray's direction, to the
+    /// first cell beyond it along the ray;
     /// false when the ray leaves the grid or ends first. On the axes it does not leave the
     /// cube by, the walk lands in the cell under the exit point, kept within the cube and
     /// never behind its current cell, so rounding cannot move it backwards or sideways. In
@@ -226,10 +227,10 @@ impl CellWalk {
         } else {
             self.cell.round_down(unit_shift).to_floats()
         };
-        // The cube's far faces: past `base` by `side` units upwards, or `side − 1` below
-        // `base` downwards (`base + unit − side·unit`); within the grid.
+        // The cube's far faces: `side` cells past `base` upwards, or `side` cells below the
+        // unit's top face downwards (`base + unit − side`); within the grid.
         let corner = base + (Vec3A::ONE - self.up) * unit;
-        let reach = Vec3A::splat(side * unit);
+        let reach = Vec3A::splat(side);
         let far = (self.step_f * reach + corner).clamp(Vec3A::ZERO, self.resolution_f);
         // Where the ray crosses them: `slope·far + offset`, expanded so that the reach,
         // the last value to arrive, enters in one multiply-add (for a cube of cells, the
@@ -430,7 +431,7 @@ mod tests {
 
     /// Leaving a cube in one step lands where the plain 3D-DDA, stepping cell by cell,
     /// first leaves it (or both find the ray ends first), for cubes of cells and of
-    /// macrocells, rays from inside the grid in every direction, axis-parallel ones
+    /// macrocells and cubes of any side in cells with a macrocell in their corner, rays from inside the grid in every direction, axis-parallel ones
     /// included. Where the exit point lies within rounding of a face on another axis,
     /// the two may break the tie differently; such rays must be rare.
     #[test]
@@ -457,17 +458,17 @@ mod tests {
                 continue;
             };
             let unit = if k % 2 == 0 { 1 } else { 8 };
-            let side = 1 + (k / 2 % 4) as i32;
+            // In cells: whole units, and (for units of 8) any side from one unit up.
+            let side = match k / 2 % 6 {
+                n @ 0..4 => (1 + n as i32) * unit,
+                _ => unit + (k / 12 % 24) as i32,
+            };
             let base = start.cell().div_euclid(IVec3::splat(unit)) * unit;
             let (lo, hi) = (
+                IVec3::select(start.step().cmpgt(IVec3::ZERO), base, base + unit - side),
                 IVec3::select(
                     start.step().cmpgt(IVec3::ZERO),
-                    base,
-                    base - (side - 1) * unit,
-                ),
-                IVec3::select(
-                    start.step().cmpgt(IVec3::ZERO),
-                    base + side * unit - 1,
+                    base + side - 1,
                     base + unit - 1,
                 ),
             );

@@ -2,8 +2,8 @@
 //!
 //! The cells are grouped in macrocells of 8³. One word per macrocell says either where its
 //! record is, or — for an empty macrocell — how far empty space reaches from it towards
-//! each octant of directions ([`super::reach`]), so the walk can leap over a whole box of
-//! empty macrocells. A record holds the 512 occupancy bits of its cells, the ranks, and
+//! each octant of directions ([`super::reach`]), so the walk can leap over a whole cube of
+//! empty cells. A record holds the 512 occupancy bits of its cells, the ranks, and
 //! for each octant how far empty space reaches from each cell ([`super::cell_reach`]); a
 //! ray entering the macrocell asks for the occupancy, the ranks and its own octant's
 //! reaches at once. Occupied cells are numbered macrocell by macrocell, so an occupied
@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 use super::box_counts::BoxCounts;
 use super::cell_reach::{self, CellReaches, OctantReaches};
-use super::reach::{self, MAX_REACH};
+use super::reach::{self, MAX_CODE};
 
 /// A macrocell is 2^MACRO_SHIFT cells along each axis.
 pub(super) const MACRO_SHIFT: i32 = 3;
@@ -123,7 +123,10 @@ impl CellIndex {
             ranks.push(first);
         }
         index.offsets.push(total);
-        index.fill_reaches();
+        let cells = BoxCounts::new(resolution.as_ivec3(), |c| {
+            blocks[CellIndex::storage_key(macro_resolution, c.as_uvec3())] > 0
+        });
+        index.fill_reaches(&cells);
         let reaches = index.cell_reaches_of(&occupancy);
         index.first_cells = ranks.iter().map(|r| r[0]).collect();
         index.records = occupancy
@@ -139,10 +142,9 @@ impl CellIndex {
         index
     }
 
-    /// The reaches of the empty macrocells ([`reach`]).
-    fn fill_reaches(&mut self) {
-        let words = &self.macro_cells;
-        let packed = reach::reaches(self.macro_resolution.as_ivec3(), |i| words[i] & EMPTY == 0);
+    /// The reaches of the empty macrocells ([`reach`]), from the counts of occupied cells.
+    fn fill_reaches(&mut self, cells: &BoxCounts) {
+        let packed = reach::reaches(self.macro_resolution.as_ivec3(), cells);
         for (word, reaches) in self.macro_cells.iter_mut().zip(packed) {
             if *word & EMPTY != 0 {
                 *word = EMPTY | reaches;
@@ -203,8 +205,8 @@ impl CellIndex {
         }
     }
 
-    /// The record of cell `c`'s macrocell, or (`Err`) when it is empty its reach towards
-    /// `octant` ([`reach`]).
+    /// The record of cell `c`'s macrocell, or (`Err`) when it is empty the code of its
+    /// reach towards `octant` ([`reach`]).
     #[inline(always)]
     pub fn macrocell_of(&self, c: IVec3, octant: u32) -> Result<usize, u32> {
         let word = self.macro_cells[self.macro_index(c >> MACRO_SHIFT)];
@@ -293,9 +295,8 @@ impl CellIndex {
         {
             return Err("a record's first cell is not its first rank".into());
         }
-        let macro_counts = BoxCounts::new(self.macro_resolution.as_ivec3(), |c| {
-            self.macro_cells[self.macro_index(c)] & EMPTY == 0
-        });
+        let r = resolution.as_ivec3();
+        let counts = BoxCounts::new(r, |c| matches!(self.lookup(c, 0), Lookup::Blocks(_)));
         for (c, word) in self.macrocells() {
             if word & EMPTY == 0 {
                 if self.records[word as usize].bits.iter().all(|&b| b == 0) {
@@ -304,12 +305,27 @@ impl CellIndex {
                 continue;
             }
             for octant in 0..8 {
-                let k = reach::unpack(word, octant);
-                check_reach(&macro_counts, c, octant, k, MAX_REACH)
-                    .map_err(|e| format!("empty macrocell {e}"))?;
+                let code = reach::unpack(word, octant);
+                let cube = |code| {
+                    let side = reach::side(code) as i32;
+                    reach::cube_box(c << MACRO_SHIFT, 1 << MACRO_SHIFT, octant, side)
+                };
+                let (lo, hi) = cube(code);
+                if counts.count(lo, hi) != 0 {
+                    return Err(format!(
+                        "empty macrocell {c} reaches {code} towards octant {octant}, \
+                         past an occupied cell"
+                    ));
+                }
+                let (lo, hi) = cube(code + 1);
+                if code < MAX_CODE && counts.count(lo, hi) == 0 {
+                    return Err(format!(
+                        "empty macrocell {c} reaches only {code} towards octant {octant}"
+                    ));
+                }
             }
         }
-        self.validate_cell_reaches(resolution)
+        self.validate_cell_reaches(r, &counts)
     }
 }
 
@@ -317,9 +333,7 @@ impl CellIndex {
     /// Checks every stored cell reach against a count of occupied cells in boxes
     /// ([`BoxCounts`]): the cube it promises holds none, and (below the cap) the cube one
     /// cell larger holds one.
-    fn validate_cell_reaches(&self, resolution: UVec3) -> Result<(), String> {
-        let r = resolution.as_ivec3();
-        let counts = BoxCounts::new(r, |c| matches!(self.lookup(c, 0), Lookup::Blocks(_)));
+    fn validate_cell_reaches(&self, r: IVec3, counts: &BoxCounts) -> Result<(), String> {
         for z in 0..r.z {
             for y in 0..r.y {
                 for x in 0..r.x {
@@ -328,7 +342,7 @@ impl CellIndex {
                         let Lookup::EmptyCell { reach: k } = self.lookup(c, octant) else {
                             continue;
                         };
-                        check_reach(&counts, c, octant, k, cell_reach::MAX_REACH)
+                        check_reach(counts, c, octant, k, cell_reach::MAX_REACH)
                             .map_err(|e| format!("cell {e}"))?;
                     }
                 }
@@ -338,17 +352,16 @@ impl CellIndex {
     }
 }
 
-/// Checks a reach `k` of `c` (a macrocell or a cell, counted in `counts`) towards
-/// `octant`: the box it promises holds nothing occupied, and — below `cap` — the box one
-/// larger does.
+/// Checks a reach `k` of cell `c` towards `octant` ([`cell_reach`]): the cube it promises
+/// holds no occupied cell of `counts`, and — below `cap` — the cube one larger does.
 fn check_reach(counts: &BoxCounts, c: IVec3, octant: u32, k: u32, cap: u32) -> Result<(), String> {
-    let (lo, hi) = reach::reach_box(c, octant, k);
+    let (lo, hi) = reach::cube_box(c, 1, octant, k as i32);
     if k < 1 || counts.count(lo, hi) != 0 {
         return Err(format!(
             "{c} reaches {k} towards octant {octant}, past an occupied one"
         ));
     }
-    let (lo, hi) = reach::reach_box(c, octant, k + 1);
+    let (lo, hi) = reach::cube_box(c, 1, octant, k as i32 + 1);
     if k < cap && counts.count(lo, hi) == 0 {
         return Err(format!("{c} reaches only {k} towards octant {octant}"));
     }

@@ -378,10 +378,11 @@ impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
                     grid.cells.prefetch_record(record, self.octant);
                     record
                 }
-                Err(reach) => {
+                Err(code) => {
                     stats.leap_macrocells();
-                    // Past the empty cube of `reach` macrocells ahead ([`reach`]).
-                    if !walk.leave_cube(reach.max(1) as f32, MACRO_SHIFT as u32) {
+                    // Past the empty cube of cells ahead in this macrocell's corner
+                    // ([`reach`]).
+                    if !walk.leave_cube(reach::side(code), MACRO_SHIFT as u32) {
                         self.walk = None;
                         return Ahead::Found(None);
                     }
