@@ -1,8 +1,10 @@
 //! Counting the occupied cells of any box of a 3D grid in constant time, from a table of
-//! sums (a summed-area table in three dimensions, Crow 1984): for checking that the
-//! distances the walk leaps by never pass over an occupied cell.
+//! sums (a summed-area table in three dimensions, Crow 1984): for finding how far the
+//! walk may leap from an empty macrocell ([`super::reach`]), and for checking that no
+//! leap passes over an occupied cell.
 
 use glam::IVec3;
+use rayon::prelude::*;
 
 /// Occupied cells per box of a grid of `resolution` cells.
 pub(super) struct BoxCounts {
@@ -13,31 +15,41 @@ pub(super) struct BoxCounts {
 }
 
 impl BoxCounts {
-    /// The table for a grid whose cell `c` is occupied when `occupied(c)`.
-    pub fn new(resolution: IVec3, occupied: impl Fn(IVec3) -> bool) -> BoxCounts {
-        let mut counts = BoxCounts {
-            resolution,
-            sums: vec![0; ((resolution + 1).as_uvec3().element_product()) as usize],
-        };
-        for z in 0..resolution.z {
-            for y in 0..resolution.y {
-                for x in 0..resolution.x {
-                    let own = u32::from(occupied(IVec3::new(x, y, z)));
-                    let at = |dx: i32, dy: i32, dz: i32| counts.sum(x + dx, y + dy, z + dz);
-                    let value = own
-                        .wrapping_add(at(0, 1, 1))
-                        .wrapping_add(at(1, 0, 1))
-                        .wrapping_add(at(1, 1, 0))
-                        .wrapping_sub(at(0, 0, 1))
-                        .wrapping_sub(at(0, 1, 0))
-                        .wrapping_sub(at(1, 0, 0))
-                        .wrapping_add(at(0, 0, 0));
-                    let i = counts.index(x + 1, y + 1, z + 1);
-                    counts.sums[i] = value;
+    /// The table for a grid whose cell `c` is occupied when `occupied(c)`: the occupancy
+    /// summed along x, then y, then z, one axis at a time (each pass over rows or planes
+    /// that are independent, in parallel where they are).
+    pub fn new(resolution: IVec3, occupied: impl Fn(IVec3) -> bool + Sync) -> BoxCounts {
+        let (sx, sy) = (resolution.x as usize + 1, resolution.y as usize + 1);
+        let plane = sx * sy;
+        let mut sums = vec![0u32; plane * (resolution.z as usize + 1)];
+        // Along x, then y, within each plane of constant z (the first plane stays 0).
+        sums.par_chunks_mut(plane)
+            .skip(1)
+            .enumerate()
+            .for_each(|(z, plane)| {
+                for y in 0..resolution.y {
+                    let row = &mut plane[sx * (y as usize + 1)..][..sx];
+                    let mut sum = 0;
+                    for x in 0..resolution.x {
+                        sum += u32::from(occupied(IVec3::new(x, y, z as i32)));
+                        row[x as usize + 1] = sum;
+                    }
                 }
+                for y in 1..sy {
+                    let (before, rest) = plane.split_at_mut(sx * y);
+                    for (sum, below) in rest[..sx].iter_mut().zip(&before[sx * (y - 1)..]) {
+                        *sum = sum.wrapping_add(*below);
+                    }
+                }
+            });
+        // Along z.
+        for z in 1..resolution.z as usize + 1 {
+            let (before, rest) = sums.split_at_mut(plane * z);
+            for (sum, below) in rest[..plane].iter_mut().zip(&before[plane * (z - 1)..]) {
+                *sum = sum.wrapping_add(*below);
             }
         }
-        counts
+        BoxCounts { resolution, sums }
     }
 
     fn index(&self, x: i32, y: i32, z: i32) -> usize {
