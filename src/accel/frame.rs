@@ -431,9 +431,10 @@ mod tests {
 
     /// Leaving a cube in one step lands where the plain 3D-DDA, stepping cell by cell,
     /// first leaves it (or both find the ray ends first), for cubes of cells and of
-    /// macrocells and cubes of any side in cells with a macrocell in their corner, rays from inside the grid in every direction, axis-parallel ones
-    /// included. Where the exit point lies within rounding of a face on another axis,
-    /// the two may break the tie differently; such rays must be rare.
+    /// macrocells and cubes of any side in cells with a macrocell in their corner, rays
+    /// from inside the grid in every direction, axis-parallel ones included. Where the exit
+    /// point lies within rounding of a face on another axis, the two may break the tie
+    /// differently; such rays must be rare.
     #[test]
     fn leaving_a_cube_lands_where_the_cell_walk_leaves_it() {
         let resolution = UVec3::new(40, 24, 33);
