@@ -142,11 +142,7 @@ impl Grid {
         }
         let CellOrder { counts, sorted } = parts.sort(&chunks, keys);
         drop(chunks);
-        let blocks_per_cell: Vec<u32> = counts
-            .par_iter()
-            .map(|n| n.div_ceil(LANES as u32))
-            .collect();
-        let cells = CellIndex::build(self.frame.resolution, &blocks_per_cell);
+        let cells = CellIndex::build(self.frame.resolution, &counts, LANES as u32);
         // Each block's run of the sorted triangle numbers (start, length), in key order as
         // the index numbers them (empty macrocells, most of the grid, are passed over
         // whole).

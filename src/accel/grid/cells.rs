@@ -87,13 +87,13 @@ impl CellIndex {
         macro_index * MACRO_CELLS + local_index(l.as_ivec3())
     }
 
-    /// The index of a grid whose cell with storage key `k` holds `blocks[k]` blocks, laid
-    /// out in key order.
-    pub fn build(resolution: UVec3, blocks: &[u32]) -> CellIndex {
+    /// The index of a grid whose cell with storage key `k` holds `triangles[k]` triangles,
+    /// in blocks of `lanes`, laid out in key order.
+    pub fn build(resolution: UVec3, triangles: &[u32], lanes: u32) -> CellIndex {
         let macro_resolution = CellIndex::macro_resolution_for(resolution);
         let m = macro_resolution;
         let macro_count = (m.x * m.y * m.z) as usize;
-        debug_assert_eq!(blocks.len(), macro_count * MACRO_CELLS);
+        debug_assert_eq!(triangles.len(), macro_count * MACRO_CELLS);
         let mut index = CellIndex {
             macro_resolution,
             macro_cells: vec![EMPTY; macro_count],
@@ -102,7 +102,7 @@ impl CellIndex {
         let mut total = 0u32;
         let mut occupancy = Vec::new();
         let mut ranks = Vec::new();
-        for (mi, cells) in blocks.chunks(MACRO_CELLS).enumerate() {
+        for (mi, cells) in triangles.chunks(MACRO_CELLS).enumerate() {
             if cells.iter().all(|&n| n == 0) {
                 continue;
             }
@@ -116,7 +116,7 @@ impl CellIndex {
                 if n > 0 {
                     bits[l >> 6] |= 1 << (l & 63);
                     index.offsets.push(total);
-                    total += n;
+                    total += n.div_ceil(lanes);
                 }
             }
             occupancy.push(bits);
@@ -124,7 +124,7 @@ impl CellIndex {
         }
         index.offsets.push(total);
         let cells = BoxCounts::new(resolution.as_ivec3(), |c| {
-            blocks[CellIndex::storage_key(macro_resolution, c.as_uvec3())] > 0
+            triangles[CellIndex::storage_key(macro_resolution, c.as_uvec3())] > 0
         });
         index.fill_reaches(&cells);
         let reaches = index.cell_reaches_of(&occupancy);
