@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Runs the accelerator benchmark (benches/accel.rs) in several fresh processes and prints,
+# per model and ray set, the grid/Embree median of each process and the median and range
+# over the processes.
+#
+#   tools/accel-bench-processes.sh [PROCESSES]      (default 7)
+#
+# Why: on the development VM the speed of all three structures changes from one process to
+# the next (Embree's on the full dragon's outside rays from 2.0 to 4.1 Mrays/s, the grid's
+# from 1.4 to 2.1), far more than between the runs inside one process, which share one
+# placement of every structure in memory. One process's median is one draw; this gives the
+# spread of the draws. The ACCEL_BENCH_* variables are passed on (for example
+# ACCEL_BENCH_MODELS=dragon_vrip.ply.gz ACCEL_BENCH_RUNS=3 ACCEL_BENCH_RAYS=50000); the
+# processes run one after another, so keep the machine otherwise idle.
+set -euo pipefail
+root=$(git rev-parse --show-toplevel)
+processes=${1:-7}
+export LD_LIBRARY_PATH="$root/.embree4${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+cd "$root"
+cargo bench --bench accel --no-run --quiet
+rows=$(mktemp)
+trap 'rm -f "$rows"' EXIT
+for ((p = 1; p <= processes; p++)); do
+  echo "accel-bench-processes: process $p of $processes" >&2
+  # Table rows: | model | triangles | set | grid | Embree | CWBVH | grid/Embree median (range) | ...
+  cargo bench --bench accel --quiet 2>/dev/null |
+    awk -F'|' -v p="$p" '$2 ~ /\.ply/ && $4 !~ /rays/ {
+      gsub(/ /, "", $2); gsub(/ /, "", $4); split($8, r, " ");
+      print p, $2, $4, r[1] }' >> "$rows"
+done
+echo "| model | set | grid/Embree median of each process | median | range |"
+echo "|---|---|---|---|---|"
+awk '{ key = $2 " " $3; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
+       values[key] = values[key] " " $4 }
+     END {
+       for (i = 1; i <= n; i++) {
+         key = order[i]; m = split(substr(values[key], 2), v, " ");
+         # Insertion sort of the m values.
+         for (a = 2; a <= m; a++) { x = v[a]; for (b = a - 1; b >= 1 && v[b] > x; b--) v[b + 1] = v[b]; v[b + 1] = x }
+         median = (m % 2) ? v[(m + 1) / 2] : (v[m / 2] + v[m / 2 + 1]) / 2
+         split(key, k, " ")
+         printf "| %s | %s |%s | %.2f | %.2f–%.2f |\n", k[1], k[2], values[key], median, v[1], v[m]
+       }
+     }' "$rows"
