@@ -26,6 +26,7 @@
 #[path = "../tests/oracles/mod.rs"]
 mod oracles;
 
+use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use gridtrace::accel::{Grid, Ray, TraversalCounts, TraversalStats};
@@ -87,20 +88,27 @@ fn run_once(rays: &[Ray], queries: &[Query], run: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The grid's time per ray split between its walk and its triangles, ns per ray of the
-/// query and of the walk alone to where the query's hit lies (`stops`, [`Grid::walk`]),
-/// each chunk timed as in [`run_once`] (best of `REPEATS`, the two in rotating order).
-fn walk_split(grid: &Grid, rays: &[Ray], stops: &[f32], run: usize) -> (f64, f64) {
+/// The medians over `runs` runs of the two figures `run_pair(run)` gives.
+fn medians_of_runs(runs: usize, run_pair: impl Fn(usize) -> (f64, f64)) -> (f64, f64) {
+    let pairs: Vec<(f64, f64)> = (0..runs).map(run_pair).collect();
+    (
+        summary(pairs.iter().map(|p| p.0).collect()).0,
+        summary(pairs.iter().map(|p| p.1).collect()).0,
+    )
+}
+
+/// Two queries over the same `count` rays, ns per ray of each: every chunk of `CHUNK` rays
+/// timed as in [`run_once`] (best of `REPEATS`, the two in rotating order); `query(q,
+/// range)` runs query `q` over the rays in `range`.
+fn time_two(count: usize, run: usize, query: impl Fn(usize, Range<usize>) -> usize) -> (f64, f64) {
     let mut total = [Duration::ZERO; 2];
-    for (c, (chunk, stops)) in rays.chunks(CHUNK).zip(stops.chunks(CHUNK)).enumerate() {
+    for c in 0..count.div_ceil(CHUNK) {
+        let range = c * CHUNK..((c + 1) * CHUNK).min(count);
         for k in 0..2 {
             let q = (k + c + run) % 2;
             let best = (0..REPEATS)
                 .map(|_| {
-                    let (answers, t) = timed(|| match q {
-                        0 => chunk.iter().filter(|r| grid.intersect(r).is_some()).count(),
-                        _ => chunk.iter().zip(stops).map(|(r, &s)| grid.walk(r, s)).sum(),
-                    });
+                    let (answers, t) = timed(|| query(q, range.clone()));
                     std::hint::black_box(answers);
                     t
                 })
@@ -109,8 +117,24 @@ fn walk_split(grid: &Grid, rays: &[Ray], stops: &[f32], run: usize) -> (f64, f64
             total[q] += best;
         }
     }
-    let per_ray = |t: Duration| t.as_secs_f64() * 1e9 / rays.len() as f64;
+    let per_ray = |t: Duration| t.as_secs_f64() * 1e9 / count as f64;
     (per_ray(total[0]), per_ray(total[1]))
+}
+
+/// The grid's time per ray split between its walk and its triangles, ns per ray of the
+/// query and of the walk alone to where the query's hit lies (`stops`, [`Grid::walk`]).
+fn walk_split(grid: &Grid, rays: &[Ray], stops: &[f32], run: usize) -> (f64, f64) {
+    time_two(rays.len(), run, |q, range| match q {
+        0 => rays[range]
+            .iter()
+            .filter(|r| grid.intersect(r).is_some())
+            .count(),
+        _ => rays[range.clone()]
+            .iter()
+            .zip(&stops[range])
+            .map(|(r, &s)| grid.walk(r, s))
+            .sum(),
+    })
 }
 
 /// Each ray of `rays` begun just before the first occupied cell it meets (`t_min` moved
@@ -160,27 +184,15 @@ fn first_cell_starts(grid: &Grid, rays: &[Ray]) -> (Vec<Ray>, usize) {
 }
 
 /// The grid's ns per ray over `rays` and over `starts` (the same rays begun elsewhere,
-/// [`first_cell_starts`]), each chunk timed as in [`run_once`].
+/// [`first_cell_starts`]).
 fn approach_split(grid: &Grid, rays: &[Ray], starts: &[Ray], run: usize) -> (f64, f64) {
-    let mut total = [Duration::ZERO; 2];
-    for (c, pair) in rays.chunks(CHUNK).zip(starts.chunks(CHUNK)).enumerate() {
-        for k in 0..2 {
-            let q = (k + c + run) % 2;
-            let chunk = if q == 0 { pair.0 } else { pair.1 };
-            let best = (0..REPEATS)
-                .map(|_| {
-                    let (hits, t) =
-                        timed(|| chunk.iter().filter(|r| grid.intersect(r).is_some()).count());
-                    std::hint::black_box(hits);
-                    t
-                })
-                .min()
-                .unwrap();
-            total[q] += best;
-        }
-    }
-    let per_ray = |t: Duration| t.as_secs_f64() * 1e9 / rays.len() as f64;
-    (per_ray(total[0]), per_ray(total[1]))
+    time_two(rays.len(), run, |q, range| {
+        let set = if q == 0 { rays } else { starts };
+        set[range]
+            .iter()
+            .filter(|r| grid.intersect(r).is_some())
+            .count()
+    })
 }
 
 /// The grid over `mesh`, with `density` cells per triangle or the density it chooses.
@@ -446,11 +458,8 @@ fn main() {
                     .iter()
                     .map(|r| grid.intersect(r).map_or(f32::INFINITY, |h| h.t))
                     .collect();
-                let splits: Vec<(f64, f64)> = (0..runs)
-                    .map(|run| walk_split(&grid, rays, &stops, run))
-                    .collect();
-                let (query, ..) = summary(splits.iter().map(|s| s.0).collect());
-                let (walk, ..) = summary(splits.iter().map(|s| s.1).collect());
+                let (query, walk) =
+                    medians_of_runs(runs, |run| walk_split(&grid, rays, &stops, run));
                 notes.push(format!(
                     "{model}, {name} rays, grid ns per ray as in the table (median of {runs}): query {query:.0}, of which the walk alone {walk:.0} ({:.0} %), the triangles' reads and tests {:.0}",
                     100.0 * walk / query,
@@ -483,11 +492,8 @@ fn main() {
                 };
                 if rays.iter().all(outside) {
                     let (starts, none) = first_cell_starts(&grid, rays);
-                    let splits: Vec<(f64, f64)> = (0..runs)
-                        .map(|run| approach_split(&grid, rays, &starts, run))
-                        .collect();
-                    let (query, ..) = summary(splits.iter().map(|s| s.0).collect());
-                    let (begun, ..) = summary(splits.iter().map(|s| s.1).collect());
+                    let (query, begun) =
+                        medians_of_runs(runs, |run| approach_split(&grid, rays, &starts, run));
                     notes.push(format!(
                         "{model}, {name} rays, the approach to the surface: begun at its first occupied cell (an oracle; {none} of {} rays meet none and cost only the clip), the grid takes {begun:.0} ns per ray against the query's {query:.0} (median of {runs}): the approach is {:.0} % of the query",
                         rays.len(),
