@@ -26,12 +26,14 @@ for ((p = 1; p <= processes; p++)); do
   cargo bench --bench accel --quiet 2>/dev/null |
     awk -F'|' -v p="$p" '$2 ~ /\.ply/ && $4 !~ /rays/ {
       gsub(/ /, "", $2); gsub(/ /, "", $4); split($8, r, " ");
-      print p, $2, $4, r[1] }' >> "$rows"
+      gsub(/ /, "", $6); print p, $2, $4, r[1], $6 }' >> "$rows"
 done
-echo "| model | set | grid/Embree median of each process | median | range |"
-echo "|---|---|---|---|---|"
+# Embree's speed per process tells how fast memory was in it (the grid's ratio is lower
+# where memory is fast: docs/grid.md, "Closing account").
+echo "| model | set | grid/Embree median of each process | median | range | Embree Mrays/s of each process |"
+echo "|---|---|---|---|---|---|"
 awk '{ key = $2 " " $3; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
-       values[key] = values[key] " " $4 }
+       values[key] = values[key] " " $4; speeds[key] = speeds[key] " " $5 }
      END {
        for (i = 1; i <= n; i++) {
          key = order[i]; m = split(substr(values[key], 2), v, " ");
@@ -39,6 +41,6 @@ awk '{ key = $2 " " $3; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
          for (a = 2; a <= m; a++) { x = v[a]; for (b = a - 1; b >= 1 && v[b] > x; b--) v[b + 1] = v[b]; v[b + 1] = x }
          median = (m % 2) ? v[(m + 1) / 2] : (v[m / 2] + v[m / 2 + 1]) / 2
          split(key, k, " ")
-         printf "| %s | %s |%s | %.2f | %.2f–%.2f |\n", k[1], k[2], values[key], median, v[1], v[m]
+         printf "| %s | %s |%s | %.2f | %.2f–%.2f |%s |\n", k[1], k[2], values[key], median, v[1], v[m], speeds[key]
        }
      }' "$rows"
