@@ -15,15 +15,21 @@ pub(super) const LANES: usize = 8;
 /// The id of an unused lane; its triangle (all zero) is never hit.
 pub(super) const NO_TRIANGLE: u32 = u32::MAX;
 
-/// Up to eight triangles as vertex and edges per axis, with their mesh indices.
+/// Up to eight triangles as vertex and edges per axis, with their mesh indices. Aligned to
+/// cache lines, so that a block (five lines) never straddles a sixth, which the walk's
+/// request for its lines ([`crate::accel::prefetch::prefetch`]) would not ask for: the
+/// allocator's placement of the block array does not decide it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(32))]
+#[repr(C, align(64))]
 pub(super) struct Block {
     v0: [[f32; LANES]; 3],
     e1: [[f32; LANES]; 3],
     e2: [[f32; LANES]; 3],
     ids: [u32; LANES],
 }
+
+// Blocks fill whole cache lines, one after another.
+const _: () = assert!(std::mem::size_of::<Block>().is_multiple_of(64));
 
 /// The nearest hit in a block: lane, parameter and barycentrics.
 #[derive(Clone, Copy, Debug)]
