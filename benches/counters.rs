@@ -38,6 +38,19 @@ fn settling_pass(rays: &[Ray], query: Query) -> usize {
     rays.iter().filter(|r| query(black_box(r))).count()
 }
 
+/// A structure's shadow query (`occlusion`) or its closest-hit query, as one function.
+fn query_of<'a>(
+    occlusion: bool,
+    intersect: impl Fn(&Ray) -> bool + 'a,
+    occluded: impl Fn(&Ray) -> bool + 'a,
+) -> Box<dyn Fn(&Ray) -> bool + 'a> {
+    if occlusion {
+        Box::new(occluded)
+    } else {
+        Box::new(intersect)
+    }
+}
+
 fn env_or(name: &str, default: &str) -> String {
     std::env::var(name).unwrap_or_else(|_| default.to_string())
 }
@@ -63,33 +76,29 @@ fn main() {
         }
         other => panic!("COUNTERS_SET {other:?}: one of outside, camera, bounce, shadow"),
     };
-    let hits = match structure.as_str() {
+    // Built in the arm that needs it, borrowed by the query.
+    let (grid, embree);
+    let query = match structure.as_str() {
         "grid" => {
-            let grid = Grid::from_mesh(mesh.positions.clone(), &mesh.indices);
-            let query = |r: &Ray| {
-                if occlusion {
-                    grid.occluded(r)
-                } else {
-                    grid.intersect(r).is_some()
-                }
-            };
-            settling_pass(&rays, &query);
-            counted_pass(&rays, &query)
+            grid = Grid::from_mesh(mesh.positions.clone(), &mesh.indices);
+            query_of(
+                occlusion,
+                |r| grid.intersect(r).is_some(),
+                |r| grid.occluded(r),
+            )
         }
         "embree" => {
-            let embree = Embree::build(&mesh);
-            let query = |r: &Ray| {
-                if occlusion {
-                    embree.occluded(r)
-                } else {
-                    embree.intersect(r).is_some()
-                }
-            };
-            settling_pass(&rays, &query);
-            counted_pass(&rays, &query)
+            embree = Embree::build(&mesh);
+            query_of(
+                occlusion,
+                |r| embree.intersect(r).is_some(),
+                |r| embree.occluded(r),
+            )
         }
         other => panic!("COUNTERS_STRUCTURE {other:?}: grid or embree"),
     };
+    settling_pass(&rays, &*query);
+    let hits = counted_pass(&rays, &*query);
     println!(
         "{model} {structure} {set}: {} rays, {hits} hits",
         rays.len()
