@@ -29,7 +29,7 @@ for ((p = 1; p <= processes; p++)); do
       gsub(/ /, "", $6); print p, $2, $4, r[1], $6 }' >> "$rows"
 done
 # Embree's speed per process tells how fast memory was in it (the grid's ratio is lower
-# where memory is fast: docs/grid.md, "Closing account").
+# where memory is fast: docs/grid.md, "Where the grid stands").
 echo "| model | set | grid/Embree median of each process | median | range | Embree Mrays/s of each process |"
 echo "|---|---|---|---|---|---|"
 awk '{ key = $2 " " $3; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
