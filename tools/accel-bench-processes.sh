@@ -11,19 +11,29 @@
 # placement of every structure in memory. One process's median is one draw; this gives the
 # spread of the draws. The ACCEL_BENCH_* variables are passed on (for example
 # ACCEL_BENCH_MODELS=dragon_vrip.ply.gz ACCEL_BENCH_RUNS=3 ACCEL_BENCH_RAYS=50000); the
-# processes run one after another, so keep the machine otherwise idle.
+# processes run one after another, so keep the machine otherwise idle. The benchmark is
+# built once and that copy is what every process runs: sources edited during the run do not
+# change what is measured (each process used to run `cargo bench`, which rebuilt them).
 set -euo pipefail
 root=$(git rev-parse --show-toplevel)
 processes=${1:-7}
 export LD_LIBRARY_PATH="$root/.embree4${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 cd "$root"
-cargo bench --bench accel --no-run --quiet
-rows=$(mktemp)
-trap 'rm -f "$rows"' EXIT
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+built=$(cargo bench --bench accel --no-run --quiet --message-format=json |
+  sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -n 1)
+[ -x "$built" ] || {
+  echo "accel-bench-processes: could not find the built benchmark" >&2
+  exit 1
+}
+cp "$built" "$work/accel"
+echo "accel-bench-processes: $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src benches || echo ' with uncommitted changes'), built once" >&2
+rows=$work/rows
 for ((p = 1; p <= processes; p++)); do
   echo "accel-bench-processes: process $p of $processes" >&2
   # Table rows: | model | triangles | set | grid | Embree | CWBVH | grid/Embree median (range) | ...
-  cargo bench --bench accel --quiet 2>/dev/null |
+  "$work/accel" --bench 2>/dev/null |
     awk -F'|' -v p="$p" '$2 ~ /\.ply/ && $4 !~ /rays/ {
       gsub(/ /, "", $2); gsub(/ /, "", $4); split($8, r, " ");
       gsub(/ /, "", $6); print p, $2, $4, r[1], $6 }' >> "$rows"
