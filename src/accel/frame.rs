@@ -82,12 +82,12 @@ impl GridFrame {
         (self.cell_of(b.min - pad), self.cell_of(b.max + pad))
     }
 
-    /// Clips the ray to the box and finds the first cell; `None` when it misses the box.
-    /// In vector lanes, with no `f32::min`/`max` (whose NaN handling costs more than the
-    /// rest): lanes that could be NaN are chosen away first. Inlined, so that it is
-    /// compiled with the caller's instruction set.
+    /// The part of `ray` within the box: where it enters and leaves it, within the ray's
+    /// own extent, with what the walk's start needs; `None` when it misses the box. In
+    /// vector lanes, with no `f32::min`/`max` (whose NaN handling costs more than the
+    /// rest): lanes that could be NaN are chosen away first.
     #[inline(always)]
-    pub fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
+    fn clip(&self, ray: &Ray) -> Option<Clip> {
         let origin = Vec3A::from(ray.origin);
         let direction = Vec3A::from(ray.direction);
         if !(origin.is_finite() && direction.is_finite()) {
@@ -120,6 +120,54 @@ impl GridFrame {
         if t_start > t_end || t_start.is_nan() || t_end.is_nan() {
             return None;
         }
+        Some(Clip {
+            origin,
+            direction,
+            inv,
+            moving,
+            inside,
+            t0,
+            t_start,
+            t_end,
+        })
+    }
+
+    /// The part of `ray` within the box, reversed: from the point where the ray leaves the
+    /// box (or ends) back to where it enters it (or starts), with its extent lengthened by
+    /// a ten-thousandth. A walk along it visits, in the opposite order, the cells a walk
+    /// along `ray` visits: both start points lie within a few rounding errors of the true
+    /// ones, far inside the margin by which cells are grown when they are filled
+    /// ([`GridFrame::pad`]). `None` when the ray misses the box (a walk along `ray` finds
+    /// no cell either) or has no finite end within it (a direction of no length). For
+    /// shadow queries, whose answer does not depend on the order of the cells.
+    #[inline(always)]
+    pub fn reversed(&self, ray: &Ray) -> Option<Ray> {
+        let clip = self.clip(ray)?;
+        let end = ray.at(clip.t_end);
+        end.is_finite().then(|| Ray {
+            origin: end,
+            direction: -ray.direction,
+            t_min: 0.0,
+            t_max: (clip.t_end - clip.t_start) * 1.0001,
+            time: ray.time,
+        })
+    }
+
+    /// Clips the ray to the box and finds the first cell; `None` when it misses the box.
+    /// Inlined, so that it is compiled with the caller's instruction set.
+    #[inline(always)]
+    pub fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
+        let Clip {
+            origin,
+            direction,
+            inv,
+            moving,
+            inside,
+            t0,
+            t_start,
+            t_end,
+        } = self.clip(ray)?;
+        let lo = Vec3A::from(self.bounds.min);
         let resolution_f = self.resolution.as_vec3a();
         let at = origin + direction * t_start;
         let cell_f = truncate(
@@ -160,6 +208,24 @@ impl GridFrame {
         walk.t_next = walk.slope * walk.face + walk.offset;
         Some(walk)
     }
+}
+
+/// A ray clipped to a grid's box ([`GridFrame::clip`]).
+#[derive(Clone, Copy)]
+struct Clip {
+    origin: Vec3A,
+    direction: Vec3A,
+    /// `1 / direction`.
+    inv: Vec3A,
+    /// The axes the ray moves along (not parallel to).
+    moving: BVec3A,
+    /// The axes whose slab holds the origin strictly inside.
+    inside: BVec3A,
+    /// Where the ray crosses the box's lower face on each axis.
+    t0: Vec3A,
+    /// The ray's parameters where it enters and leaves the box, within its extent.
+    t_start: f32,
+    t_end: f32,
 }
 
 /// The walk of one ray through the cells it crosses, front to back.

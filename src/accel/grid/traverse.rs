@@ -234,9 +234,21 @@ impl Grid {
         self.occluded_portable(ray, stats)
     }
 
+    /// The cells are walked from the segment's far end back to its origin (the answer does
+    /// not depend on their order, and each triangle is still tested against `ray` itself,
+    /// so it is the one a forward walk gives). A shadow segment starts on the surface it
+    /// leaves, whose cells hold triangles that cannot block it, and ends on a light or
+    /// beyond the box: walked from that end, a blocked segment stops at the blocker nearest
+    /// the end without testing the triangles around its origin. Full dragon, 50,000
+    /// segments (`tools/grid-ab.sh`): 0.81 the time of the forward walk, identical answers;
+    /// 11k dragon 0.99.
     #[inline(always)]
     fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        let mut cells = self.occupied_cells::<true>(ray);
+        let walked = match self.frame.resolution {
+            UVec3::ONE => *ray,
+            _ => self.frame.reversed(ray).unwrap_or(*ray),
+        };
+        let mut cells = self.occupied_cells::<true>(&walked);
         while let Some((range, _)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
@@ -539,6 +551,72 @@ mod tests {
         assert!(
             hits > 1_000 && counts.pauses > 500,
             "{hits} hits, {counts:?}"
+        );
+    }
+
+    /// A shadow query, whose cells are walked from the segment's far end, finds what testing
+    /// every triangle finds: for segments ending exactly at their nearest hit, one ulp past
+    /// it and anywhere, segments to infinity, rays from inside and outside the box, rays
+    /// starting just before a triangle (the walk's last cell decides), and rays along an
+    /// axis in the planes of cell faces (where a walk from either end meets cell boundaries
+    /// at every step).
+    #[test]
+    fn a_shadow_query_walked_from_the_far_end_finds_what_testing_every_triangle_finds() {
+        let triangles = sphere(50);
+        let grid = Grid::build(triangles.clone());
+        let frame = grid.frame;
+        let mut rng = crate::render::sampling::Rng::new(41, 4);
+        let (mut blocked, mut rays) = (0, 0);
+        for k in 0..4_000 {
+            let mut u = || rng.uniform() * 2.0 - 1.0;
+            let (origin, direction) = if k % 4 == 3 {
+                // On cell faces of two axes, along the third.
+                let axis = k / 4 % 3;
+                let face = |a: usize, x: f32| {
+                    let cells = (x * 0.5 + 0.5) * frame.resolution[a] as f32;
+                    frame.bounds.min[a] + cells.round() * frame.cell_size[a]
+                };
+                let mut o = Vec3::new(face(0, u()), face(1, u()), face(2, u()));
+                o[axis] = if k % 8 < 4 { -2.0 } else { 0.3 * u() };
+                let mut d = Vec3::ZERO;
+                d[axis] = if k % 3 == 0 { -1.0 } else { 1.0 };
+                (o, d)
+            } else if k % 4 == 2 {
+                // Just before a point of a triangle, as a shadow ray leaving a surface is:
+                // the blocker lies at the end where the walk from the far end stops.
+                let t = &triangles[((u() * 0.5 + 0.5) * triangles.len() as f32) as usize];
+                let d = Vec3::new(u(), u(), u()).normalize();
+                let (a, b, back) = (u() * 0.25 + 0.25, u() * 0.25 + 0.25, u() * 5e-5 + 5e-5);
+                (t.v0 + a * t.e1 + b * t.e2 - d * back, d)
+            } else {
+                let o = Vec3::new(u(), u(), u()) * if k % 2 == 0 { 2.5 } else { 0.9 };
+                (o, Vec3::new(u(), u(), u()).normalize())
+            };
+            let ray = Ray::new(origin, direction);
+            let nearest = triangles
+                .iter()
+                .filter_map(|t| t.intersect(&ray, f32::INFINITY))
+                .map(|h| h.t)
+                .reduce(f32::min);
+            let ends = [
+                nearest.unwrap_or(1.0),
+                nearest.map_or(2.0, |t| t.next_up()),
+                4.0 * rng.uniform(),
+                f32::INFINITY,
+            ];
+            for t_max in ends {
+                let segment = ray.with_t_max(t_max);
+                let expected = triangles
+                    .iter()
+                    .any(|t| t.intersect(&segment, t_max).is_some());
+                assert_eq!(grid.occluded(&segment), expected, "ray {k}: {segment:?}");
+                blocked += usize::from(expected);
+                rays += 1;
+            }
+        }
+        assert!(
+            blocked > rays / 4 && blocked < rays * 3 / 4,
+            "{blocked} of {rays}"
         );
     }
 
