@@ -1,9 +1,10 @@
 //! The grid against Embree 4 (`rtcIntersect1`/`rtcOccluded1`) and the obvhs CWBVH on the
 //! Stanford dragon at several sizes: build time (median of 5, the three built in turn),
 //! memory per triangle (each structure's own allocation: Embree's memory monitor, obvhs'
-//! node and index arrays, the grid's arrays), and single-thread throughput on four ray
-//! sets — rays from outside, a pinhole camera's rays, bounce rays from the surface, and
-//! shadow segments (`occluded`).
+//! node and index arrays, the grid's arrays), and single-thread throughput on five ray
+//! sets — rays from outside, a pinhole camera's rays, bounce rays from the surface, shadow
+//! segments (`occluded`: the bounce rays cut to random lengths), and light segments (shadow
+//! segments as light sampling makes them, from the surface to a square light above it).
 //!
 //! Timing: each set is cut into chunks of 10,000 rays; for every chunk the three structures
 //! take turns (in rotating order), each keeping the best of 7 repeats, so drifts of the
@@ -33,7 +34,7 @@ use gridtrace::accel::{Grid, Ray, TraversalCounts, TraversalStats};
 use gridtrace::load::ply;
 use gridtrace::scene::Aabb;
 use oracles::embree::Embree;
-use oracles::rays::{bounce_rays, camera_rays, outside_rays, segments};
+use oracles::rays::{bounce_rays, camera_rays, light_segments, outside_rays, segments};
 use oracles::{Mesh, Obvhs, dragon_path};
 use rayon::prelude::*;
 
@@ -400,11 +401,16 @@ fn main() {
         let bounds = Aabb::from_points(mesh.positions.iter().copied());
         let bounce = bounce_rays(&triangles, count, 22);
         let shadow = segments(&bounce, 0.3 * bounds.extent().length(), 23);
-        let sets: [(&str, Vec<Ray>, bool); 4] = [
+        let sets: [(&str, Vec<Ray>, bool); 5] = [
             ("outside", outside_rays(&bounds, count, 21), false),
             ("camera", camera_rays(&bounds, count), false),
             ("bounce", bounce, false),
             ("shadow", shadow, true),
+            (
+                "light",
+                light_segments(&triangles, &bounds, count, 24),
+                true,
+            ),
         ];
         for (name, rays, occlusion) in &sets {
             let queries: Vec<Query> = if *occlusion {

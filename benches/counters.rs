@@ -7,7 +7,7 @@
 //!
 //! Not a timing: run under `tools/accel-counters.sh`. Environment: `COUNTERS_MODEL` (a file
 //! of data/dragon, default the full dragon), `COUNTERS_STRUCTURE` (`grid` or `embree`),
-//! `COUNTERS_SET` (`outside`, `camera`, `bounce` or `shadow`), `COUNTERS_RAYS` (default
+//! `COUNTERS_SET` (`outside`, `camera`, `bounce`, `shadow` or `light`), `COUNTERS_RAYS` (default
 //! 10,000).
 
 #[path = "../tests/oracles/mod.rs"]
@@ -19,7 +19,7 @@ use gridtrace::accel::{Grid, Ray};
 use gridtrace::load::ply;
 use gridtrace::scene::Aabb;
 use oracles::embree::Embree;
-use oracles::rays::{bounce_rays, camera_rays, outside_rays, segments};
+use oracles::rays::{bounce_rays, camera_rays, light_segments, outside_rays, segments};
 use oracles::{Mesh, dragon_path};
 
 type Query<'a> = &'a dyn Fn(&Ray) -> bool;
@@ -74,7 +74,8 @@ fn main() {
             let bounce = bounce_rays(&mesh.triangles(), count, 22);
             (segments(&bounce, 0.3 * bounds.extent().length(), 23), true)
         }
-        other => panic!("COUNTERS_SET {other:?}: one of outside, camera, bounce, shadow"),
+        "light" => (light_segments(&mesh.triangles(), &bounds, count, 24), true),
+        other => panic!("COUNTERS_SET {other:?}: one of outside, camera, bounce, shadow, light"),
     };
     // Built in the arm that needs it, borrowed by the query.
     let (grid, embree);

@@ -58,6 +58,41 @@ pub fn segments(rays: &[Ray], max_length: f32, seed: u64) -> Vec<Ray> {
         .collect()
 }
 
+/// Shadow segments as the renderer's light sampling makes them: from uniform random points of
+/// the surface whose outward side (the winding's, `e1 × e2`) faces a square light above the
+/// box, towards a uniform random point of the light, both ends off their surfaces by their
+/// rounding-error bounds and the segment stopped short of the light by 10⁻⁴ of its length.
+/// The light is a fifth of the box's width across, half the box's height above it. (For the
+/// benchmark and `tools/grid-ab`; the cross-check does not use them.)
+#[allow(dead_code)]
+pub fn light_segments(triangles: &[Triangle], bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng::new(seed, 4);
+    let live: Vec<&Triangle> = triangles.iter().filter(|t| !t.is_degenerate()).collect();
+    let extent = bounds.extent();
+    let light_center = bounds.center() + Vec3::Y * extent.y;
+    let half = 0.1 * extent.x;
+    let mut segments = Vec::with_capacity(count);
+    while segments.len() < count {
+        let tri = live[((rng.uniform() * live.len() as f32) as usize).min(live.len() - 1)];
+        let b = uniform_triangle(rng.uniform2());
+        let corners = tri.vertices().map(|v| (v, Vec3::ZERO));
+        let (p, error) = interpolate_with_error(corners, [1.0 - b.x - b.y, b.x, b.y]);
+        let light = light_center
+            + Vec3::new(rng.uniform() * 2.0 - 1.0, 0.0, rng.uniform() * 2.0 - 1.0) * half;
+        let n = tri.e1.cross(tri.e2).normalize();
+        let towards = light - p;
+        if n.dot(towards) <= 0.0 {
+            continue;
+        }
+        let origin = offset_ray_origin(p, error, n, towards);
+        segments.push(Ray {
+            t_max: 1.0 - 1e-4,
+            ..Ray::new(origin, light - origin)
+        });
+    }
+    segments
+}
+
 /// A pinhole camera's rays: from one point framing the box, through a square image. (For
 /// the benchmark and `tools/grid-ab`; the cross-check does not use them.)
 #[allow(dead_code)]

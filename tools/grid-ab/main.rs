@@ -60,7 +60,8 @@ fn main() {
                 0.3 * bounds.extent().length(),
                 23,
             ),
-            other => panic!("unknown ray set {other}: outside, camera, bounce or shadow"),
+            "light" => rays::light_segments(&triangles, &bounds, count, 24),
+            other => panic!("unknown ray set {other}: outside, camera, bounce, shadow or light"),
         };
         let base_rays: Vec<gridtrace_base::accel::Ray> = rays
             .iter()
@@ -70,7 +71,7 @@ fn main() {
                 b
             })
             .collect();
-        let shadow = set == "shadow";
+        let shadow = set == "shadow" || set == "light";
         let trace_new = |chunk: &[Ray]| {
             chunk
                 .iter()
