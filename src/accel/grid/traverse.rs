@@ -237,11 +237,12 @@ impl Grid {
     /// The cells are walked from the segment's far end back to its origin (the answer does
     /// not depend on their order, and each triangle is still tested against `ray` itself,
     /// so it is the one a forward walk gives). A shadow segment starts on the surface it
-    /// leaves, whose cells hold triangles that cannot block it, and ends on a light or
-    /// beyond the box: walked from that end, a blocked segment stops at the blocker nearest
-    /// the end without testing the triangles around its origin. Full dragon, 50,000
-    /// segments (`tools/grid-ab.sh`): 0.81 the time of the forward walk, identical answers;
-    /// 11k dragon 0.99.
+    /// leaves, whose cells are crowded with triangles that seldom block it, and ends on a
+    /// light or beyond the box: walked from that end, a blocked segment stops at the
+    /// blocker nearest the end without testing them. Against the forward walk, identical
+    /// answers (`tools/grid-ab.sh`, 50,000 segments each): light segments 0.61–0.64 the
+    /// time on the full dragon, 0.73 on the 203k, 0.95 on the 11k; the bounce rays cut to
+    /// random lengths 0.81, 0.88 and 1.01; from points a camera sees, 0.99 (full).
     #[inline(always)]
     fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         let walked = match self.frame.resolution {
