@@ -157,19 +157,11 @@ impl GridFrame {
     /// Inlined, so that it is compiled with the caller's instruction set.
     #[inline(always)]
     pub fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
-        let Clip {
-            origin,
-            direction,
-            inv,
-            moving,
-            inside,
-            t0,
-            t_start,
-            t_end,
-        } = self.clip(ray)?;
+        let clip = self.clip(ray)?;
+        let (origin, direction, moving) = (clip.origin, clip.direction, clip.moving);
         let lo = Vec3A::from(self.bounds.min);
         let resolution_f = self.resolution.as_vec3a();
-        let at = origin + direction * t_start;
+        let at = origin + direction * clip.t_start;
         let cell_f = truncate(
             ((at - lo) * Vec3A::from(self.inv_cell_size))
                 .max(Vec3A::ZERO)
@@ -186,8 +178,8 @@ impl GridFrame {
             direction * Vec3A::from(self.inv_cell_size),
             Vec3A::ZERO,
         );
-        let slope = Vec3A::select(moving, Vec3A::from(self.cell_size) * inv, Vec3A::ZERO);
-        let offset = Vec3A::select(moving, t0, Vec3A::INFINITY);
+        let slope = Vec3A::select(moving, Vec3A::from(self.cell_size) * clip.inv, Vec3A::ZERO);
+        let offset = Vec3A::select(moving, clip.t0, Vec3A::INFINITY);
         let mut walk = CellWalk {
             cell: CellLanes::truncating(cell_f),
             step: CellLanes::truncating(step_f),
@@ -196,8 +188,8 @@ impl GridFrame {
             slope,
             offset,
             t_next: Vec3A::INFINITY,
-            t_end,
-            from_outside: !inside.all(),
+            t_end: clip.t_end,
+            from_outside: !clip.inside.all(),
             cells_per_t,
             cells_at_zero: Vec3A::select(moving, -offset * cells_per_t, cell_f + Vec3A::splat(0.5)),
             up: Vec3A::select(up, Vec3A::ONE, Vec3A::ZERO),
