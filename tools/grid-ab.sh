@@ -7,7 +7,8 @@
 #   tools/grid-ab.sh HEAD dragon_vrip.ply.gz outside,camera,bounce,shadow 5
 #
 # BASE is any commit; MODEL a file of data/dragon (tools/fetch-dragon.sh); SETS a
-# comma-separated choice of outside, camera, bounce, shadow and light; GRID_AB_RAYS rays per set
+# comma-separated choice of outside, camera, bounce, shadow, light and seen (pairs: a camera
+# ray, then the light segment from its hit, traced in that order); GRID_AB_RAYS rays per set
 # (default 50,000); GRID_AB_DENSITY builds this tree's grid at that many cells per
 # triangle instead of the density it chooses (the base keeps its choice). Prints, per set,
 # how many answers differ (there should be none unless the change means them to) and the

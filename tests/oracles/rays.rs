@@ -60,37 +60,86 @@ pub fn segments(rays: &[Ray], max_length: f32, seed: u64) -> Vec<Ray> {
 
 /// Shadow segments as the renderer's light sampling makes them: from uniform random points of
 /// the surface whose outward side (the winding's, `e1 × e2`) faces a square light above the
-/// box, towards a uniform random point of the light, both ends off their surfaces by their
-/// rounding-error bounds and the segment stopped short of the light by 10⁻⁴ of its length.
-/// The light is a fifth of the box's width across, half the box's height above it. (For the
-/// benchmark and `tools/grid-ab`; the cross-check does not use them.)
+/// box, towards a uniform random point of the light ([`light_segment`]). (For the benchmark
+/// and `tools/grid-ab`; the cross-check does not use them.)
 #[allow(dead_code)]
 pub fn light_segments(triangles: &[Triangle], bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
     let mut rng = Rng::new(seed, 4);
     let live: Vec<&Triangle> = triangles.iter().filter(|t| !t.is_degenerate()).collect();
-    let extent = bounds.extent();
-    let light_center = bounds.center() + Vec3::Y * extent.y;
-    let half = 0.1 * extent.x;
     let mut segments = Vec::with_capacity(count);
     while segments.len() < count {
         let tri = live[((rng.uniform() * live.len() as f32) as usize).min(live.len() - 1)];
         let b = uniform_triangle(rng.uniform2());
-        let corners = tri.vertices().map(|v| (v, Vec3::ZERO));
-        let (p, error) = interpolate_with_error(corners, [1.0 - b.x - b.y, b.x, b.y]);
-        let light = light_center
-            + Vec3::new(rng.uniform() * 2.0 - 1.0, 0.0, rng.uniform() * 2.0 - 1.0) * half;
         let n = tri.e1.cross(tri.e2).normalize();
-        let towards = light - p;
-        if n.dot(towards) <= 0.0 {
-            continue;
-        }
-        let origin = offset_ray_origin(p, error, n, towards);
-        segments.push(Ray {
-            t_max: 1.0 - 1e-4,
-            ..Ray::new(origin, light - origin)
-        });
+        segments.extend(light_segment(
+            tri,
+            [1.0 - b.x - b.y, b.x, b.y],
+            n,
+            bounds,
+            &mut rng,
+        ));
     }
     segments
+}
+
+/// Each of a pinhole camera's rays ([`camera_rays`]) that hits the mesh, followed by the light
+/// segment from its hit on the side it sees, when that side faces the light: the order in
+/// which the renderer traces them, so that the segment starts in cells the camera ray has
+/// just read. `nearest` gives a ray's hit: parameter, barycentrics `u`, `v` and triangle.
+/// (For `tools/grid-ab`'s `seen` set, which times each pair together.)
+#[allow(dead_code)]
+pub fn seen_light_pairs(
+    triangles: &[Triangle],
+    bounds: &Aabb,
+    count: usize,
+    seed: u64,
+    nearest: impl Fn(&Ray) -> Option<(f32, f32, f32, u32)>,
+) -> Vec<Ray> {
+    let mut rng = Rng::new(seed, 5);
+    let mut pairs = Vec::with_capacity(2 * count);
+    for ray in camera_rays(bounds, 16 * count) {
+        if pairs.len() == 2 * count {
+            break;
+        }
+        let Some((_, u, v, id)) = nearest(&ray) else {
+            continue;
+        };
+        let tri = &triangles[id as usize];
+        let n = tri.e1.cross(tri.e2).normalize();
+        let seen = if n.dot(ray.direction) > 0.0 { -n } else { n };
+        if let Some(segment) = light_segment(tri, [1.0 - u - v, u, v], seen, bounds, &mut rng) {
+            pairs.extend([ray, segment]);
+        }
+    }
+    pairs
+}
+
+/// The segment from the point of `tri` at barycentrics `b` to a uniform random point of a
+/// square light above the box (a fifth of its width across, half its height above it), as
+/// `direct_light` makes it: the origin off the surface by the point's rounding-error bound
+/// on the side of `n`, the segment stopped short of the light by 10⁻⁴ of its length. `None`
+/// when that side faces away from the light.
+fn light_segment(
+    tri: &Triangle,
+    b: [f32; 3],
+    n: Vec3,
+    bounds: &Aabb,
+    rng: &mut Rng,
+) -> Option<Ray> {
+    let extent = bounds.extent();
+    let offset = Vec3::new(rng.uniform() * 2.0 - 1.0, 0.0, rng.uniform() * 2.0 - 1.0);
+    let half = 0.1 * extent.x;
+    let light = bounds.center() + Vec3::Y * extent.y + offset * half;
+    let corners = tri.vertices().map(|v| (v, Vec3::ZERO));
+    let (p, error) = interpolate_with_error(corners, b);
+    let towards = light - p;
+    (n.dot(towards) > 0.0).then(|| {
+        let origin = offset_ray_origin(p, error, n, towards);
+        Ray {
+            t_max: 1.0 - 1e-4,
+            ..Ray::new(origin, light - origin)
+        }
+    })
 }
 
 /// A pinhole camera's rays: from one point framing the box, through a square image. (For

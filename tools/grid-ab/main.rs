@@ -16,7 +16,9 @@ use gridtrace::scene::Aabb;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let model = args.get(1).map_or("dragon_vrip.ply.gz", String::as_str);
-    let sets = args.get(2).map_or("outside,camera,bounce,shadow", String::as_str);
+    let sets = args
+        .get(2)
+        .map_or("outside,camera,bounce,shadow", String::as_str);
     let rounds: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(5);
     let count: usize = std::env::var("GRID_AB_RAYS")
         .ok()
@@ -61,7 +63,14 @@ fn main() {
                 23,
             ),
             "light" => rays::light_segments(&triangles, &bounds, count, 24),
-            other => panic!("unknown ray set {other}: outside, camera, bounce, shadow or light"),
+            // Pairs: a camera ray, then the light segment from its hit.
+            "seen" => rays::seen_light_pairs(&triangles, &bounds, count / 2, 25, |r| {
+                base.intersect(&gridtrace_base::accel::Ray::new(r.origin, r.direction))
+                    .map(|h| (h.t, h.u, h.v, h.triangle))
+            }),
+            other => {
+                panic!("unknown ray set {other}: outside, camera, bounce, shadow, light or seen")
+            }
         };
         let base_rays: Vec<gridtrace_base::accel::Ray> = rays
             .iter()
@@ -71,24 +80,45 @@ fn main() {
                 b
             })
             .collect();
-        let shadow = set == "shadow" || set == "light";
+        // Shadow queries; for `seen`, every second ray (each after the camera ray whose hit
+        // it starts from, traced in that order).
+        let shadow = |i: usize| match set {
+            "shadow" | "light" => true,
+            "seen" => i % 2 == 1,
+            _ => false,
+        };
         let trace_new = |chunk: &[Ray]| {
             chunk
                 .iter()
-                .filter(|r| if shadow { new.occluded(r) } else { new.intersect(r).is_some() })
+                .enumerate()
+                .filter(|(i, r)| {
+                    if shadow(*i) {
+                        new.occluded(r)
+                    } else {
+                        new.intersect(r).is_some()
+                    }
+                })
                 .count()
         };
         let trace_base = |chunk: &[gridtrace_base::accel::Ray]| {
             chunk
                 .iter()
-                .filter(|r| if shadow { base.occluded(r) } else { base.intersect(r).is_some() })
+                .enumerate()
+                .filter(|(i, r)| {
+                    if shadow(*i) {
+                        base.occluded(r)
+                    } else {
+                        base.intersect(r).is_some()
+                    }
+                })
                 .count()
         };
         let differ = rays
             .iter()
             .zip(&base_rays)
-            .filter(|(r, b)| {
-                if shadow {
+            .enumerate()
+            .filter(|(i, (r, b))| {
+                if shadow(*i) {
                     new.occluded(r) != base.occluded(b)
                 } else {
                     new.intersect(r).map(|h| (h.t, h.triangle))
@@ -108,7 +138,11 @@ fn main() {
         let mut ratios: Vec<f64> = (0..rounds)
             .map(|round| {
                 let (mut t_new, mut t_base) = (0.0, 0.0);
-                for (c, (a, b)) in rays.chunks(10_000).zip(base_rays.chunks(10_000)).enumerate() {
+                for (c, (a, b)) in rays
+                    .chunks(10_000)
+                    .zip(base_rays.chunks(10_000))
+                    .enumerate()
+                {
                     for turn in 0..2 {
                         if (turn + c + round) % 2 == 0 {
                             t_new += best_of_7(&|| trace_new(a));
