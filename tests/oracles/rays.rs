@@ -37,10 +37,9 @@ pub fn bounce_rays(triangles: &[Triangle], count: usize, seed: u64) -> Vec<Ray> 
     let live: Vec<&Triangle> = triangles.iter().filter(|t| !t.is_degenerate()).collect();
     (0..count)
         .map(|_| {
-            let tri = live[((rng.uniform() * live.len() as f32) as usize).min(live.len() - 1)];
-            let b = uniform_triangle(rng.uniform2());
+            let (tri, b) = surface_point(&live, &mut rng);
             let corners = tri.vertices().map(|v| (v, Vec3::ZERO));
-            let (p, error) = interpolate_with_error(corners, [1.0 - b.x - b.y, b.x, b.y]);
+            let (p, error) = interpolate_with_error(corners, b);
             let side = if rng.uniform() < 0.5 { 1.0 } else { -1.0 };
             let n = side * tri.e1.cross(tri.e2).normalize();
             let direction = Frame::from_normal(n).to_world(cosine_hemisphere(rng.uniform2()));
@@ -48,6 +47,14 @@ pub fn bounce_rays(triangles: &[Triangle], count: usize, seed: u64) -> Vec<Ray> 
             Ray::new(offset_ray_origin(p, error, n, direction), direction)
         })
         .collect()
+}
+
+/// A uniform random point of a triangle chosen uniformly at random (not by area): the
+/// triangle and the point's barycentrics.
+fn surface_point<'a>(live: &[&'a Triangle], rng: &mut Rng) -> (&'a Triangle, [f32; 3]) {
+    let tri = live[((rng.uniform() * live.len() as f32) as usize).min(live.len() - 1)];
+    let b = uniform_triangle(rng.uniform2());
+    (tri, [1.0 - b.x - b.y, b.x, b.y])
 }
 
 /// The same rays cut to segments of random length up to `max_length`, as shadow rays are.
@@ -59,7 +66,7 @@ pub fn segments(rays: &[Ray], max_length: f32, seed: u64) -> Vec<Ray> {
 }
 
 /// Shadow segments as the renderer's light sampling makes them: from uniform random points of
-/// the surface whose outward side (the winding's, `e1 × e2`) faces a square light above the
+/// random triangles ([`surface_point`]) whose outward side (the winding's, `e1 × e2`) faces a square light above the
 /// box, towards a uniform random point of the light ([`light_segment`]). (For the benchmark
 /// and `tools/grid-ab`; the cross-check does not use them.)
 #[allow(dead_code)]
@@ -68,16 +75,9 @@ pub fn light_segments(triangles: &[Triangle], bounds: &Aabb, count: usize, seed:
     let live: Vec<&Triangle> = triangles.iter().filter(|t| !t.is_degenerate()).collect();
     let mut segments = Vec::with_capacity(count);
     while segments.len() < count {
-        let tri = live[((rng.uniform() * live.len() as f32) as usize).min(live.len() - 1)];
-        let b = uniform_triangle(rng.uniform2());
+        let (tri, b) = surface_point(&live, &mut rng);
         let n = tri.e1.cross(tri.e2).normalize();
-        segments.extend(light_segment(
-            tri,
-            [1.0 - b.x - b.y, b.x, b.y],
-            n,
-            bounds,
-            &mut rng,
-        ));
+        segments.extend(light_segment(tri, b, n, bounds, &mut rng));
     }
     segments
 }
