@@ -9,7 +9,8 @@
 # BASE is any commit; MODEL a file of data/dragon (tools/fetch-dragon.sh); SETS a
 # comma-separated choice of outside, camera, bounce, shadow, light and seen (pairs: a camera
 # ray, then the light segment from its hit, traced in that order); GRID_AB_RAYS rays per set
-# (default 50,000); GRID_AB_DENSITY builds this tree's grid at that many cells per
+# (default 50,000); GRID_AB_CHUNK rays per chunk (default 10,000; a few hundred
+# time the queries warm, in cache); GRID_AB_DENSITY builds this tree's grid at that many cells per
 # triangle instead of the density it chooses (the base keeps its choice). Prints, per set,
 # how many answers differ (there should be none unless the change means them to) and the
 # time of this tree over the base's, median and range of the rounds. The base is copied
