@@ -9,8 +9,9 @@ pub(crate) enum X86Level {
     Baseline,
     /// AVX2 for a block's eight lanes and the top level's eight box lanes, POPCNT for an
     /// occupied cell's rank (without it, `count_ones` is a seventeen-instruction bit trick
-    /// on every step into an occupied cell), BMI1 and BMI2 for bit tests and shifts. Every
-    /// x86-64 processor with AVX2 has the other three.
+    /// on every step into an occupied cell), BMI1 and BMI2 for bit tests and shifts, FMA
+    /// for the walk's fused multiply-adds (the grid's queries). Every x86-64 processor with
+    /// AVX2 has the other four.
     Avx2,
     /// AVX-512 F, VL, BW and DQ besides: the walk's 128-bit lanes and the blocks' 256-bit
     /// ones gain mask registers for their comparisons and selections, and 32 vector
@@ -28,6 +29,7 @@ pub(crate) fn x86_level() -> X86Level {
     static LEVEL: std::sync::OnceLock<X86Level> = std::sync::OnceLock::new();
     *LEVEL.get_or_init(|| {
         let avx2 = std::is_x86_feature_detected!("avx2")
+            && std::is_x86_feature_detected!("fma")
             && std::is_x86_feature_detected!("popcnt")
             && std::is_x86_feature_detected!("bmi1")
             && std::is_x86_feature_detected!("bmi2");

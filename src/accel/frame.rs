@@ -154,9 +154,10 @@ impl GridFrame {
     }
 
     /// Clips the ray to the box and finds the first cell; `None` when it misses the box.
-    /// Inlined, so that it is compiled with the caller's instruction set.
+    /// Inlined, so that it is compiled with the caller's instruction set; `FUSED` as in
+    /// [`CellWalk`].
     #[inline(always)]
-    pub fn start_walk(&self, ray: &Ray) -> Option<CellWalk> {
+    pub fn start_walk<const FUSED: bool>(&self, ray: &Ray) -> Option<CellWalk<FUSED>> {
         let clip = self.clip(ray)?;
         let (origin, direction, moving) = (clip.origin, clip.direction, clip.moving);
         let lo = Vec3A::from(self.bounds.min);
@@ -197,7 +198,7 @@ impl GridFrame {
             t_per_cell: slope * step_f,
         };
         walk.face = cell_f + walk.up;
-        walk.t_next = walk.slope * walk.face + walk.offset;
+        walk.t_next = mul_add::<FUSED>(walk.slope, walk.face, walk.offset);
         Some(walk)
     }
 }
@@ -224,9 +225,11 @@ struct Clip {
 ///
 /// Written without branches on the axis (the axis of each step is as good as random for
 /// bounce rays, so a branch on it would be mispredicted about every other step) and
-/// without indexing vectors by a run-time axis, so the state stays in registers.
+/// without indexing vectors by a run-time axis, so the state stays in registers. With
+/// `FUSED`, its multiply-adds are fused ([`mul_add`]): only in code compiled for
+/// processors with FMA, which the caller has checked.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct CellWalk {
+pub(crate) struct CellWalk<const FUSED: bool = false> {
     /// Current cell, in integer lanes: the next step's lookup starts from it
     /// ([`CellLanes`]).
     cell: CellLanes,
@@ -265,7 +268,7 @@ pub(crate) struct CellWalk {
     t_per_cell: Vec3A,
 }
 
-impl CellWalk {
+impl<const FUSED: bool> CellWalk<FUSED> {
     /// Moves the walk out of the empty cube of `side` cells a side (`side` ≥ `2^unit_shift`)
     /// that has the current cell's unit of `2^unit_shift` cells a side (units aligned to
     /// multiples of their size) in its corner and extends in the ray's direction, to the
@@ -303,7 +306,7 @@ impl CellWalk {
         } else {
             self.slope * corner + self.offset
         };
-        let t_far = self.t_per_cell * reach + at_corner;
+        let t_far = mul_add::<FUSED>(self.t_per_cell, reach, at_corner);
         let (t_exit, chosen) = first_exit(t_far);
         // The cube's last cells (`far − 1` upwards, `far` downwards), and the cell beyond
         // on the exit axis (`far` upwards, `far − 1` downwards).
@@ -323,12 +326,16 @@ impl CellWalk {
         // within the grid does not have) truncates to `i32::MIN` on x86-64 (elsewhere `as`
         // saturates), so the clamp puts it on one of the cube's sides; the walk goes on
         // from there.
-        let under = CellLanes::truncating(self.cells_per_t * t_exit + self.cells_at_zero);
+        let under = CellLanes::truncating(mul_add::<FUSED>(
+            self.cells_per_t,
+            t_exit,
+            self.cells_at_zero,
+        ));
         let (lo, hi) = (cell.min(last), cell.max(last));
         let side_cell = under.clamp(CellLanes::truncating(lo), CellLanes::truncating(hi));
         self.cell = CellLanes::select(chosen, CellLanes::truncating(next), side_cell);
         self.face = self.cell.to_floats() + self.up;
-        self.t_next = self.slope * self.face + self.offset;
+        self.t_next = mul_add::<FUSED>(self.slope, self.face, self.offset);
         true
     }
 
@@ -350,7 +357,7 @@ impl CellWalk {
             .cell
             .add(CellLanes::select(axis, self.step, CellLanes::zero()));
         self.face += moved;
-        self.t_next = self.slope * self.face + self.offset;
+        self.t_next = mul_add::<FUSED>(self.slope, self.face, self.offset);
         (t_exit.x, true)
     }
 
@@ -386,6 +393,26 @@ fn first_exit(t: Vec3A) -> (Vec3A, BVec3A) {
         (x & le_next & le_after) | (y & le_next & lt_after) | (!(x | y) & lt_next & lt_after);
     // The least lane in every lane, from the same rotations: no broadcast after it.
     (t.min(next).min(after), first)
+}
+
+/// `a·b + c` in each lane: with `FUSED`, one fused multiply-add (rounded once, and a step
+/// shorter on the walk's chain of dependent operations: the warm queries of the full dragon
+/// 0.97–0.99 the time, `tools/grid-ab.sh` with `GRID_AB_CHUNK=250`), else a multiply and an
+/// add. `FUSED` is set only by the grid's queries compiled with the `fma` feature, chosen
+/// at run time on processors that have it ([`crate::accel::cpu::x86_level`]); elsewhere it
+/// is false.
+#[inline(always)]
+fn mul_add<const FUSED: bool>(a: Vec3A, b: Vec3A, c: Vec3A) -> Vec3A {
+    #[cfg(target_arch = "x86_64")]
+    if FUSED {
+        use std::arch::x86_64::{__m128, _mm_fmadd_ps};
+        // SAFETY: `FUSED` is true only in the queries compiled for FMA, which run only on
+        // processors that have it (see above).
+        return Vec3A::from(unsafe {
+            _mm_fmadd_ps(__m128::from(a), __m128::from(b), __m128::from(c))
+        });
+    }
+    a * b + c
 }
 
 /// `v` rounded towards zero (as whole-number floats): `floor` for the non-negative
@@ -469,7 +496,7 @@ mod tests {
             UVec3::splat(4),
         );
         let ray = Ray::new(Vec3::new(-1.0, 0.5, 0.5), Vec3::new(1.0, 0.0, 0.0));
-        let mut walk = frame.start_walk(&ray).unwrap();
+        let mut walk = frame.start_walk::<false>(&ray).unwrap();
         let mut cells = vec![walk.cell()];
         loop {
             let x = walk.cell().x;
@@ -513,7 +540,7 @@ mod tests {
                 direction[k / 10 % 3] = 0.0;
             }
             let ray = Ray::new(origin, direction.normalize());
-            let Some(start) = frame.start_walk(&ray) else {
+            let Some(start) = frame.start_walk::<false>(&ray) else {
                 continue;
             };
             let unit = if k % 2 == 0 { 1 } else { 8 };

@@ -99,7 +99,7 @@ impl InstanceGrid {
     /// Calls `visit` with the instances of each non-empty cell along the ray, front to back,
     /// and the largest ray parameter that belongs to the cell, until it returns true.
     pub fn walk(&self, ray: &Ray, mut visit: impl FnMut(&[u32], f32) -> bool) {
-        let Some(mut walk) = self.frame.start_walk(ray) else {
+        let Some(mut walk) = self.frame.start_walk::<false>(ray) else {
             return;
         };
         loop {

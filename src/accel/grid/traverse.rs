@@ -119,32 +119,36 @@ impl Grid {
             X86Level::Avx2 => return unsafe { self.intersect_avx2(ray, stats) },
             X86Level::Baseline => {}
         }
-        self.intersect_portable(ray, stats)
+        self.intersect_portable::<false>(ray, stats)
     }
 
     /// [`Grid::intersect_portable`] compiled for AVX2, where a block's eight lanes are one
     /// vector (the arithmetic, and so the answer, is the same).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
     fn intersect_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
-        self.intersect_portable(ray, stats)
+        self.intersect_portable::<true>(ray, stats)
     }
 
     /// [`Grid::intersect_portable`] compiled for AVX-512 ([`X86Level::Avx512`]; the same
     /// arithmetic).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
     fn intersect_avx512(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
-        self.intersect_portable(ray, stats)
+        self.intersect_portable::<true>(ray, stats)
     }
 
     #[inline(always)]
-    fn intersect_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
+    fn intersect_portable<const FUSED: bool>(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> Option<GridHit> {
         // The nearest hit found so far, wherever it lies; it is the answer once it lies
         // within the cell being visited, since every later cell lies beyond that cell.
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
-        let mut cells = self.occupied_cells::<true>(ray);
+        let mut cells = self.occupied_cells::<true, FUSED>(ray);
         while let Some((range, limit)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
@@ -173,26 +177,26 @@ impl Grid {
             X86Level::Avx2 => return unsafe { self.walk_avx2(ray, t_stop) },
             X86Level::Baseline => {}
         }
-        self.walk_portable(ray, t_stop)
+        self.walk_portable::<false>(ray, t_stop)
     }
 
     /// [`Grid::walk_portable`] compiled for AVX2, like the queries.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
     fn walk_avx2(&self, ray: &Ray, t_stop: f32) -> usize {
-        self.walk_portable(ray, t_stop)
+        self.walk_portable::<true>(ray, t_stop)
     }
 
     /// [`Grid::walk_portable`] compiled for AVX-512, like the queries.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
     fn walk_avx512(&self, ray: &Ray, t_stop: f32) -> usize {
-        self.walk_portable(ray, t_stop)
+        self.walk_portable::<true>(ray, t_stop)
     }
 
     #[inline(always)]
-    fn walk_portable(&self, ray: &Ray, t_stop: f32) -> usize {
-        let mut cells = self.occupied_cells::<false>(ray);
+    fn walk_portable<const FUSED: bool>(&self, ray: &Ray, t_stop: f32) -> usize {
+        let mut cells = self.occupied_cells::<false, FUSED>(ray);
         let mut visited = 0;
         while let Some((_, limit)) = cells.next(&mut ()) {
             visited += 1;
@@ -217,21 +221,21 @@ impl Grid {
             X86Level::Avx2 => return unsafe { self.occluded_avx2(ray, stats) },
             X86Level::Baseline => {}
         }
-        self.occluded_portable(ray, stats)
+        self.occluded_portable::<false>(ray, stats)
     }
 
     /// [`Grid::occluded_portable`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
     fn occluded_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.occluded_portable(ray, stats)
+        self.occluded_portable::<true>(ray, stats)
     }
 
     /// [`Grid::occluded_portable`] compiled for AVX-512.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
     fn occluded_avx512(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.occluded_portable(ray, stats)
+        self.occluded_portable::<true>(ray, stats)
     }
 
     /// The cells are walked from the segment's far end back to its origin (the answer does
@@ -245,12 +249,16 @@ impl Grid {
     /// random lengths 0.81, 0.88 and 1.01; light segments from a camera's hits, each traced
     /// after its camera ray (set `seen`), 0.94 on the full dragon and 1.00 on the 11k.
     #[inline(always)]
-    fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+    fn occluded_portable<const FUSED: bool>(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> bool {
         let walked = match self.frame.resolution {
             UVec3::ONE => *ray,
             _ => self.frame.reversed(ray).unwrap_or(*ray),
         };
-        let mut cells = self.occupied_cells::<true>(&walked);
+        let mut cells = self.occupied_cells::<true, FUSED>(&walked);
         while let Some((range, _)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
@@ -264,15 +272,15 @@ impl Grid {
 
     /// The occupied cells along `ray`, front to back.
     #[inline(always)]
-    fn occupied_cells<'a, const READ_BLOCKS: bool>(
+    fn occupied_cells<'a, const READ_BLOCKS: bool, const FUSED: bool>(
         &'a self,
         ray: &Ray,
-    ) -> OccupiedCells<'a, READ_BLOCKS> {
+    ) -> OccupiedCells<'a, READ_BLOCKS, FUSED> {
         let single_cell = self.frame.resolution == UVec3::ONE;
         let walk = if self.blocks.is_empty() || single_cell {
             None
         } else {
-            self.frame.start_walk(ray)
+            self.frame.start_walk::<FUSED>(ray)
         };
         OccupiedCells {
             grid: self,
@@ -288,11 +296,11 @@ impl Grid {
 
 /// The occupied cells along a ray, front to back (a cursor rather than an iterator, so the
 /// caller's statistics can ride along). Unless `READ_BLOCKS`, the cells' blocks are not
-/// asked for ahead of time ([`Grid::walk`]).
-struct OccupiedCells<'a, const READ_BLOCKS: bool> {
+/// asked for ahead of time ([`Grid::walk`]). `FUSED` as in [`CellWalk`].
+struct OccupiedCells<'a, const READ_BLOCKS: bool, const FUSED: bool> {
     grid: &'a Grid,
     /// `None` once the ray has left the grid.
-    walk: Option<CellWalk>,
+    walk: Option<CellWalk<FUSED>>,
     /// The octant of the ray's direction ([`reach::octant`]).
     octant: u32,
     /// True until the one cell of a single-cell grid has been given out: such a grid is not
@@ -330,7 +338,7 @@ impl Ahead {
 /// belongs to it (the last cell takes all up to the grid's end).
 type Found = (Range<usize>, f32);
 
-impl<const READ_BLOCKS: bool> OccupiedCells<'_, READ_BLOCKS> {
+impl<const READ_BLOCKS: bool, const FUSED: bool> OccupiedCells<'_, READ_BLOCKS, FUSED> {
     /// The next occupied cell along the ray.
     ///
     /// The walk runs one occupied cell ahead of the cell given out. Reading a cell's
@@ -636,7 +644,7 @@ mod tests {
             let direction = Vec3::new(u(), u(), u()).normalize();
             let mut ray = Ray::new(origin, direction);
             let fast = grid.intersect(&ray);
-            let portable = grid.intersect_portable(&ray, &mut ());
+            let portable = grid.intersect_portable::<false>(&ray, &mut ());
             assert_eq!(fast, portable, "ray {k}: {ray:?}");
             // On a processor with AVX-512, the AVX2 version too.
             #[cfg(target_arch = "x86_64")]
@@ -647,7 +655,7 @@ mod tests {
             }
             hits += usize::from(fast.is_some());
             ray.t_max = 1.5;
-            let blocked = grid.occluded_portable(&ray, &mut ());
+            let blocked = grid.occluded_portable::<false>(&ray, &mut ());
             assert_eq!(grid.occluded(&ray), blocked, "ray {k}: {ray:?}");
             #[cfg(target_arch = "x86_64")]
             if x86_level() >= X86Level::Avx2 {
