@@ -280,6 +280,13 @@ impl<const FUSED: bool> CellWalk<FUSED> {
     /// exit axis like [`CellWalk::advance`].
     #[inline(always)]
     pub fn leave_cube(&mut self, side: f32, unit_shift: u32) -> bool {
+        self.leave_box(Vec3A::splat(side), unit_shift)
+    }
+
+    /// [`CellWalk::leave_cube`] for a box of `sides` cells along each axis (each at least
+    /// `2^unit_shift`).
+    #[inline(always)]
+    pub fn leave_box(&mut self, sides: Vec3A, unit_shift: u32) -> bool {
         let unit = (1 << unit_shift) as f32;
         let cell = self.face - self.up;
         // The cube's corner unit, from the integer cell (for cubes of cells, the cell).
@@ -291,7 +298,7 @@ impl<const FUSED: bool> CellWalk<FUSED> {
         // The cube's far faces: `side` cells past `base` upwards, or `side` cells below the
         // unit's top face downwards (`base + unit − side`); within the grid.
         let corner = base + (Vec3A::ONE - self.up) * unit;
-        let reach = Vec3A::splat(side);
+        let reach = sides;
         let far = (self.step_f * reach + corner).clamp(Vec3A::ZERO, self.resolution_f);
         // Where the ray crosses them: `slope·far + offset`, expanded so that the reach,
         // the last value to arrive, enters in one multiply-add (for a cube of cells, the
@@ -516,10 +523,11 @@ mod tests {
 
     /// Leaving a cube in one step lands where the plain 3D-DDA, stepping cell by cell,
     /// first leaves it (or both find the ray ends first), for cubes of cells and of
-    /// macrocells and cubes of any side in cells with a macrocell in their corner, rays
-    /// from inside the grid in every direction, axis-parallel ones included. Where the exit
-    /// point lies within rounding of a face on another axis, the two may break the tie
-    /// differently; such rays must be rare.
+    /// macrocells, cubes of any side in cells with a macrocell in their corner, and boxes
+    /// of a different side along each axis with a macrocell in their corner
+    /// ([`CellWalk::leave_box`]); rays from inside the grid in every direction,
+    /// axis-parallel ones included. Where the exit point lies within rounding of a face on
+    /// another axis, the two may break the tie differently; such rays must be rare.
     #[test]
     fn leaving_a_cube_lands_where_the_cell_walk_leaves_it() {
         let resolution = UVec3::new(40, 24, 33);
@@ -549,6 +557,13 @@ mod tests {
                 n @ 0..4 => (1 + n as i32) * unit,
                 _ => unit + (k / 12 % 24) as i32,
             };
+            // Every fourth ray of a macrocell: a box, each side from one unit up.
+            let boxed = k % 8 == 1;
+            let side = if boxed {
+                IVec3::new(0, 1, 2).map(|a| unit + ((k as i32 / 8 * 7 + a * 5) % 29))
+            } else {
+                IVec3::splat(side)
+            };
             let base = start.cell().div_euclid(IVec3::splat(unit)) * unit;
             let (lo, hi) = (
                 IVec3::select(start.step().cmpgt(IVec3::ZERO), base, base + unit - side),
@@ -569,9 +584,12 @@ mod tests {
                 }
             };
             let mut leap = start;
-            let got = leap
-                .leave_cube(side as f32, unit.trailing_zeros())
-                .then_some(leap.cell());
+            let got = if boxed {
+                leap.leave_box(side.as_vec3a(), unit.trailing_zeros())
+            } else {
+                leap.leave_cube(side.x as f32, unit.trailing_zeros())
+            }
+            .then_some(leap.cell());
             if got == expected {
                 agreed += 1;
                 continue;

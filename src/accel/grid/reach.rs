@@ -1,71 +1,41 @@
 //! How far empty space reaches ahead of a ray, per empty macrocell: for each of the eight
-//! octants of directions, the side (in cells) of the largest cube of empty cells that has
-//! this macrocell in its corner and extends in that octant's directions. A ray moving into
-//! the octant from anywhere in the macrocell stays in that cube until it crosses one of the
-//! cube's far faces, so the walk leaps there in one step.
+//! octants of directions, the sides (in cells) of a box of empty cells that has this
+//! macrocell in its corner and extends in that octant's directions. A ray moving into the
+//! octant from anywhere in the macrocell stays in that box until it crosses one of the
+//! box's far faces, so the walk leaps there in one step.
 //!
 //! A distance to the nearest occupied macrocell (proximity clouds, Cohen & Sheffer 1994),
 //! which this replaces, is bounded by geometry on every side, also behind and beside the
-//! ray: a ray passing a surface, or leaving it, crept past it in short leaps. A cube with
+//! ray: a ray passing a surface, or leaving it, crept past it in short leaps. A box with
 //! its corner at the macrocell is bounded only by what lies ahead in the ray's octant (the
-//! anisotropic, per-octant distances of sparse-voxel ray marchers). Its side is counted in
-//! cells, not macrocells: the cube ends at the first occupied *cell* ahead, often well
+//! anisotropic, per-octant distances of sparse-voxel ray marchers). Its sides are counted
+//! in cells, not macrocells: the box ends at the first occupied *cell* ahead, often well
 //! inside the next occupied macrocell, so the leap lands past that macrocell's empty edge
 //! (or passes its corner altogether) instead of stopping at its face.
 //!
-//! Sides are coded in 7 bits ([`side`]): exactly up to 64 cells, in steps of about 6 %
-//! above, up to the largest grid. A code stands for the largest coded side not above the
-//! true one, so a leap never passes an occupied cell. Found for each macrocell and octant
-//! by bisection over the codes, each cube's occupied cells counted from a table of sums
-//! ([`BoxCounts`]).
+//! The box is the largest empty cube, then grown along x, y and z in turn as far as it
+//! stays empty: where a cube stops at the first occupied cell in any direction ahead, the
+//! box goes on along the axes that are still clear, so a ray leaving it by those axes' far
+//! faces leaps further (outside rays that miss the full dragon take 2.8 leaps over empty
+//! macrocells instead of 3.9; docs/grid.md, twenty-fourth session). Each side is at most
+//! [`MAX_SIDE`] cells, so the three fit in a byte each ([`CellIndex`]); found by bisection,
+//! each box's occupied cells counted from a table of sums ([`BoxCounts`]).
+//!
+//! [`CellIndex`]: super::cells::CellIndex
 
 use glam::IVec3;
 use rayon::prelude::*;
 
 use super::box_counts::BoxCounts;
 use super::cells::MACRO_SHIFT;
-use crate::accel::frame::MAX_RESOLUTION;
 
-/// The largest code of a side (7 bits each, so the eight fit in one word).
-pub(super) const MAX_CODE: u32 = 127;
-
-/// Bits per octant's code in a packed word.
-const BITS: u32 = 7;
+/// The longest side of a box, in cells: a side fits in a byte. (A ray through a grid of
+/// the largest resolution, 2048 cells a side, thus leaps at least nine times over empty
+/// space along it.)
+pub(super) const MAX_SIDE: i32 = 255;
 
 /// Cells along a macrocell's edge.
 const MACRO_SIDE: i32 = 1 << MACRO_SHIFT;
-
-/// Codes up to this stand for their own number of cells.
-const EXACT_UP_TO: usize = 64;
-
-/// The side in cells of each code: the code itself up to [`EXACT_UP_TO`], then 1/16 more
-/// per code (at least one cell); never below a macrocell's edge, which an empty macrocell's
-/// cube always has.
-const SIDES: [f32; MAX_CODE as usize + 1] = {
-    let mut sides = [0f32; MAX_CODE as usize + 1];
-    let mut side = 0u32;
-    let mut code = 0;
-    while code <= MAX_CODE as usize {
-        side = if code <= EXACT_UP_TO {
-            code as u32
-        } else {
-            side + if side / 16 > 1 { side / 16 } else { 1 }
-        };
-        sides[code] = if side < MACRO_SIDE as u32 {
-            MACRO_SIDE as f32
-        } else {
-            side as f32
-        };
-        code += 1;
-    }
-    sides
-};
-
-/// The side in cells of the cube `code` stands for ([`SIDES`]).
-#[inline(always)]
-pub(super) fn side(code: u32) -> f32 {
-    SIDES[(code & MAX_CODE) as usize]
-}
 
 /// The octant of a walk's direction: bit `a` set when it moves down axis `a` (a ray
 /// parallel to an axis counts as moving up it: it never leaves its slab of that axis).
@@ -74,32 +44,30 @@ pub(super) fn octant(step: IVec3) -> u32 {
     u32::from(step.x < 0) | u32::from(step.y < 0) << 1 | u32::from(step.z < 0) << 2
 }
 
-/// The code for `octant` in a word packed by [`reaches`].
-#[inline(always)]
-pub(super) fn unpack(word: u64, octant: u32) -> u32 {
-    (word >> (BITS * octant)) as u32 & MAX_CODE
-}
-
 /// True when a walk moving into `octant` moves up (or along) `axis` ([`octant`]).
 #[inline(always)]
 pub(super) fn moves_up(octant: u32, axis: usize) -> bool {
     octant >> axis & 1 == 0
 }
 
-/// The cells `(lo, hi)` (inclusive) of the cube of `side` cells a side that has the unit of
-/// `unit` cells a side starting at cell `corner` in its corner and extends towards
-/// `octant`: the box a reach promises empty (of a cell: `unit` 1; of a macrocell: its
-/// edge).
-pub(super) fn cube_box(corner: IVec3, unit: i32, octant: u32, side: i32) -> (IVec3, IVec3) {
+/// The cells `(lo, hi)` (inclusive) of the box of `sides` cells that has the unit of `unit`
+/// cells a side starting at cell `corner` in its corner and extends towards `octant`: the
+/// box a reach promises empty (of a cell: `unit` 1; of a macrocell: its edge).
+pub(super) fn box_cells(corner: IVec3, unit: i32, octant: u32, sides: IVec3) -> (IVec3, IVec3) {
     let up = IVec3::from_array([0, 1, 2].map(|a| i32::from(moves_up(octant, a))));
-    let lo = corner + (IVec3::ONE - up) * (unit - side);
-    (lo, lo + IVec3::splat(side - 1))
+    let lo = corner + (IVec3::ONE - up) * (IVec3::splat(unit) - sides);
+    (lo, lo + sides - 1)
 }
 
-/// Every macrocell's codes in the eight octants, packed `BITS` bits each (octant `o` at bit
-/// `BITS·o`), for a grid of `resolution` macrocells (x fastest) whose occupied cells
-/// `cells` counts; an occupied macrocell's are 0.
-pub(super) fn reaches(resolution: IVec3, cells: &BoxCounts) -> Vec<u64> {
+/// [`box_cells`] of a cube of `side` cells a side.
+pub(super) fn cube_box(corner: IVec3, unit: i32, octant: u32, side: i32) -> (IVec3, IVec3) {
+    box_cells(corner, unit, octant, IVec3::splat(side))
+}
+
+/// Per macrocell of a grid of `resolution` macrocells (x fastest) whose occupied cells
+/// `cells` counts, and per octant: the sides of its box (above), packed a byte each, x
+/// lowest; 0 for an occupied macrocell.
+pub(super) fn boxes(resolution: IVec3, cells: &BoxCounts) -> Vec<[u32; 8]> {
     let r = resolution;
     let count = (r.x * r.y * r.z) as usize;
     (0..count)
@@ -108,43 +76,64 @@ pub(super) fn reaches(resolution: IVec3, cells: &BoxCounts) -> Vec<u64> {
             let i = i as i32;
             let m = IVec3::new(i % r.x, i / r.x % r.y, i / (r.x * r.y));
             let corner = m * MACRO_SIDE;
-            let empty = |octant: u32, code: u32| {
-                let (lo, hi) = cube_box(corner, MACRO_SIDE, octant, side(code) as i32);
+            let empty = |octant: u32, sides: IVec3| {
+                let (lo, hi) = box_cells(corner, MACRO_SIDE, octant, sides);
                 cells.count(lo, hi) == 0
             };
-            if !empty(0, 0) {
-                return 0;
+            let mut packed = [0u32; 8];
+            if !empty(0, IVec3::splat(MACRO_SIDE)) {
+                return packed;
             }
-            (0..8).fold(0u64, |word, octant| {
-                // The largest code whose cube is empty: the macrocell's own (code 0)
-                // is, and cubes grow with the code.
-                let (mut low, mut high) = (0, MAX_CODE + 1);
-                while high - low > 1 {
-                    let mid = (low + high) / 2;
-                    if empty(octant, mid) {
-                        low = mid;
-                    } else {
-                        high = mid;
-                    }
-                }
-                word | u64::from(low) << (BITS * octant)
-            })
+            for (octant, entry) in (0..8).zip(&mut packed) {
+                let side = largest(MACRO_SIDE, |s| empty(octant, IVec3::splat(s)));
+                let x = largest(side, |s| empty(octant, IVec3::new(s, side, side)));
+                let y = largest(side, |s| empty(octant, IVec3::new(x, s, side)));
+                let z = largest(side, |s| empty(octant, IVec3::new(x, y, s)));
+                *entry = pack(IVec3::new(x, y, z));
+            }
+            packed
         })
         .collect()
 }
 
-/// The largest code spans any grid, so a cube that reaches past the grid's end on every
-/// axis ahead is coded as such.
-const _: () = assert!(SIDES[MAX_CODE as usize] >= MAX_RESOLUTION as f32);
+/// The largest side in `low..=MAX_SIDE` for which `fits` holds, by bisection: `fits(low)`
+/// holds, and a side for which it fails fails for every larger one (boxes nest).
+fn largest(low: i32, fits: impl Fn(i32) -> bool) -> i32 {
+    let (mut low, mut high) = (low, MAX_SIDE + 1);
+    while high - low > 1 {
+        let mid = (low + high) / 2;
+        if fits(mid) {
+            low = mid;
+        } else {
+            high = mid;
+        }
+    }
+    low
+}
+
+/// A box's sides (each in `1..=MAX_SIDE`), a byte each, x lowest.
+pub(super) fn pack(sides: IVec3) -> u32 {
+    sides.x as u32 | (sides.y as u32) << 8 | (sides.z as u32) << 16
+}
+
+/// The sides [`pack`] packed.
+pub(super) fn unpack(packed: u32) -> IVec3 {
+    IVec3::new(
+        (packed & 0xff) as i32,
+        (packed >> 8 & 0xff) as i32,
+        (packed >> 16 & 0xff) as i32,
+    )
+}
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// Each code stands for the largest coded side of an empty cube of cells in the
-    /// macrocell's corner, found by counting the cells of every cube in turn.
+    /// Each macrocell's box is empty, holds the largest empty cube, and cannot grow by a
+    /// cell along any axis without taking in an occupied cell (or passing `MAX_SIDE`), as
+    /// counting the cells of every box in turn finds.
     #[test]
-    fn reaches_are_the_largest_empty_cubes_ahead() {
+    fn boxes_are_empty_and_grown_as_far_as_they_stay_empty() {
         // Macrocells of a grid whose last ones are partly outside it.
         let (macros, cells) = (IVec3::new(5, 3, 4), IVec3::new(37, 20, 30));
         let full = [
@@ -154,47 +143,48 @@ mod tests {
             IVec3::new(9, 9, 9),
         ];
         let counts = BoxCounts::new(cells, |c| full.contains(&c));
-        let packed = reaches(macros, &counts);
+        let packed = boxes(macros, &counts);
         let index = |m: IVec3| (m.x + macros.x * (m.y + macros.y * m.z)) as usize;
-        let mut checked = 0;
+        let (mut checked, mut grown) = (0, 0);
         for z in 0..macros.z {
             for y in 0..macros.y {
                 for x in 0..macros.x {
                     let m = IVec3::new(x, y, z);
                     let corner = m * MACRO_SIDE;
-                    let empty = |o: u32, side: f32| {
-                        let (lo, hi) = cube_box(corner, MACRO_SIDE, o, side as i32);
+                    let empty = |o: u32, sides: IVec3| {
+                        let (lo, hi) = box_cells(corner, MACRO_SIDE, o, sides);
                         !full.iter().any(|f| f.cmpge(lo).all() && f.cmple(hi).all())
                     };
-                    if !empty(0, 8.0) {
-                        assert_eq!(packed[index(m)], 0, "{m}");
+                    if !empty(0, IVec3::splat(MACRO_SIDE)) {
+                        assert_eq!(packed[index(m)], [0; 8], "{m}");
                         continue;
                     }
                     for o in 0..8 {
-                        let code = unpack(packed[index(m)], o);
-                        assert!(empty(o, side(code)), "{m} octant {o}: code {code}");
-                        if code < MAX_CODE {
-                            assert!(!empty(o, side(code + 1)), "{m} octant {o}: code {code}");
+                        let sides = unpack(packed[index(m)][o as usize]);
+                        assert!(empty(o, sides), "{m} octant {o}: {sides}");
+                        let cube = (MACRO_SIDE..=MAX_SIDE)
+                            .take_while(|&s| empty(o, IVec3::splat(s)))
+                            .last();
+                        assert_eq!(Some(sides.min_element()), cube, "{m} octant {o}");
+                        for axis in 0..3 {
+                            let mut larger = sides;
+                            larger[axis] += 1;
+                            assert!(
+                                sides[axis] == MAX_SIDE || !empty(o, larger),
+                                "{m} octant {o}: {sides} grows along {axis}"
+                            );
                         }
+                        grown += usize::from(sides.max_element() > sides.min_element());
                         checked += 1;
                     }
                 }
             }
         }
-        assert!(checked > 300, "{checked}");
+        assert!(
+            checked > 300 && grown > 100,
+            "{checked} boxes, {grown} grown"
+        );
         assert_eq!(octant(IVec3::new(1, -1, 0)), 2);
         assert_eq!(octant(IVec3::new(-1, 1, -1)), 5);
-    }
-
-    /// Codes stand for their own side up to 64 cells, grow from there, and never stand for
-    /// less than a macrocell.
-    #[test]
-    fn sides_grow_with_their_codes() {
-        assert_eq!(side(0), 8.0);
-        assert_eq!(side(13), 13.0);
-        assert_eq!(side(64), 64.0);
-        for code in 8..MAX_CODE {
-            assert!(side(code + 1) > side(code), "{code}");
-        }
     }
 }

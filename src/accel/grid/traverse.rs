@@ -400,11 +400,11 @@ impl<const READ_BLOCKS: bool, const FUSED: bool> OccupiedCells<'_, READ_BLOCKS, 
                     grid.cells.prefetch_record(record, self.octant);
                     record
                 }
-                Err(code) => {
+                Err(sides) => {
                     stats.leap_macrocells();
-                    // Past the empty cube of cells ahead in this macrocell's corner
+                    // Past the empty box of cells ahead in this macrocell's corner
                     // ([`reach`]).
-                    if !walk.leave_cube(reach::side(code), MACRO_SHIFT as u32) {
+                    if !walk.leave_box(sides, MACRO_SHIFT as u32) {
                         self.walk = None;
                         return Ahead::Found(None);
                     }
