@@ -30,27 +30,41 @@ built=$(cargo bench --bench accel --no-run --quiet --message-format=json |
 cp "$built" "$work/accel"
 echo "accel-bench-processes: $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src benches tests/oracles Cargo.toml Cargo.lock || echo ' with uncommitted changes'), built once" >&2
 rows=$work/rows
+warm=$work/warm
 for ((p = 1; p <= processes; p++)); do
   echo "accel-bench-processes: process $p of $processes" >&2
   # Table rows: | model | triangles | set | grid | Embree | CWBVH | grid/Embree median (range) | ...
-  "$work/accel" --bench 2>/dev/null |
-    awk -F'|' -v p="$p" '$2 ~ /\.ply/ && $4 !~ /rays/ {
+  "$work/accel" --bench 2>/dev/null > "$work/out"
+  awk -F'|' -v p="$p" '$2 ~ /\.ply/ && $4 !~ /rays/ {
       gsub(/ /, "", $2); gsub(/ /, "", $4); split($8, r, " ");
-      gsub(/ /, "", $6); print p, $2, $4, r[1], $6 }' >> "$rows"
+      gsub(/ /, "", $6); print p, $2, $4, r[1], $6 }' "$work/out" >> "$rows"
+  # "MODEL, SET rays, ns per ray cold / warm (...): grid C / W, Embree C / W, ...": Embree's
+  # warm time over the grid's, each ray traced several times in a row (computation alone).
+  sed -n 's/^\([^,]*\), \([a-z]*\) rays, ns per ray cold \/ warm[^:]*: grid [0-9.]* \/ \([0-9.]*\), Embree [0-9.]* \/ \([0-9.]*\),.*/\1 \2 \3 \4/p' \
+    "$work/out" | awk -v p="$p" '{ printf "%d %s %s %.2f\n", p, $1, $2, $4 / $3 }' >> "$warm"
 done
-# Embree's speed per process tells how fast memory was in it (the grid's ratio is lower
-# where memory is fast: docs/grid.md, "Where the grid stands").
-echo "| model | set | grid/Embree median of each process | median | range | Embree Mrays/s of each process |"
-echo "|---|---|---|---|---|---|"
-awk '{ key = $2 " " $3; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
-       values[key] = values[key] " " $4; speeds[key] = speeds[key] " " $5 }
-     END {
-       for (i = 1; i <= n; i++) {
-         key = order[i]; m = split(substr(values[key], 2), v, " ");
-         # Insertion sort of the m values.
-         for (a = 2; a <= m; a++) { x = v[a]; for (b = a - 1; b >= 1 && v[b] > x; b--) v[b + 1] = v[b]; v[b + 1] = x }
-         median = (m % 2) ? v[(m + 1) / 2] : (v[m / 2] + v[m / 2 + 1]) / 2
-         split(key, k, " ")
-         printf "| %s | %s |%s | %.2f | %.2f–%.2f |%s |\n", k[1], k[2], values[key], median, v[1], v[m], speeds[key]
-       }
-     }' "$rows"
+# Prints a table of the rows in file $1: per model and set, the values of each process, their
+# median and range, and each process's speed ($2 and $3 head the columns).
+report() {
+  # Embree's speed per process tells how fast memory was in it (the grid's ratio is lower
+  # where memory is fast: docs/grid.md, "Where the grid stands").
+  echo "| model | set | $2 | median | range | $3 |"
+  echo "|---|---|---|---|---|---|"
+  awk '{ key = $2 " " $3; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
+         values[key] = values[key] " " $4; speeds[key] = speeds[key] " " $5 }
+       END {
+         for (i = 1; i <= n; i++) {
+           key = order[i]; m = split(substr(values[key], 2), v, " ");
+           # Insertion sort of the m values.
+           for (a = 2; a <= m; a++) { x = v[a]; for (b = a - 1; b >= 1 && v[b] > x; b--) v[b + 1] = v[b]; v[b + 1] = x }
+           median = (m % 2) ? v[(m + 1) / 2] : (v[m / 2] + v[m / 2 + 1]) / 2
+           split(key, k, " ")
+           printf "| %s | %s |%s | %.2f | %.2f–%.2f |%s |\n", k[1], k[2], values[key], median, v[1], v[m], speeds[key]
+         }
+       }' "$1"
+}
+report "$rows" "grid/Embree median of each process" "Embree Mrays/s of each process"
+echo
+echo "Warm (each ray traced several times in a row: the computation alone, memory aside):"
+awk '{ print $1, $2, $3, $4, "-" }' "$warm" > "$work/warm_rows"
+report "$work/warm_rows" "Embree/grid warm ns per ray, each process" "-"
