@@ -29,6 +29,12 @@ pub(super) const MACRO_CELLS: usize = 1 << (3 * MACRO_SHIFT);
 /// index. (An empty macrocell's word is 0.)
 const OCCUPIED: u32 = 1 << 31;
 
+/// The record a macrocell's word names, or `None` for an empty macrocell.
+#[inline(always)]
+fn record_in(word: u32) -> Option<usize> {
+    (word & OCCUPIED != 0).then_some((word & !OCCUPIED) as usize)
+}
+
 /// What the walk needs to know about one occupied macrocell, in one place so that entering
 /// the macrocell can ask for what a ray needs at once: per octant, how far empty space
 /// reaches from each cell (256 bytes, four cache lines, first so that each octant's lines
@@ -175,15 +181,15 @@ impl CellIndex {
         }
     }
 
-    /// Every macrocell's coordinates, word and boxes, x fastest.
-    fn macrocells(&self) -> impl Iterator<Item = (IVec3, u32, &[u32])> + '_ {
+    /// Every macrocell's coordinates, record (`None` when empty) and boxes, x fastest.
+    fn macrocells(&self) -> impl Iterator<Item = (IVec3, Option<usize>, &[u32])> + '_ {
         let m = self.macro_resolution;
         (0..(m.x * m.y * m.z) as usize).map(move |mi| {
             let c = dense_coordinates(m, mi);
             let slot = self.macro_index(c);
             (
                 c,
-                self.macro_words[slot],
+                record_in(self.macro_words[slot]),
                 &self.macro_boxes[slot * 8..slot * 8 + 8],
             )
         })
@@ -194,9 +200,9 @@ impl CellIndex {
     fn cell_reaches_of(&self, occupancy: &[[u64; MACRO_CELLS / 64]]) -> Vec<OctantReaches> {
         let m = self.macro_resolution.as_ivec3();
         let mut at = vec![IVec3::ZERO; occupancy.len()];
-        for (c, word, _) in self.macrocells() {
-            if word & OCCUPIED != 0 {
-                at[(word & !OCCUPIED) as usize] = c;
+        for (c, record, _) in self.macrocells() {
+            if let Some(record) = record {
+                at[record] = c;
             }
         }
         let index = self;
@@ -238,11 +244,9 @@ impl CellIndex {
     #[inline(always)]
     pub fn macrocell_of(&self, c: IVec3, octant: u32) -> Result<usize, Vec3A> {
         let slot = self.macro_index(c >> MACRO_SHIFT);
-        let word = self.macro_words[slot];
-        if word & OCCUPIED != 0 {
-            Ok((word & !OCCUPIED) as usize)
-        } else {
-            Err(byte_lanes(self.macro_boxes[slot << 3 | octant as usize]))
+        match record_in(self.macro_words[slot]) {
+            Some(record) => Ok(record),
+            None => Err(byte_lanes(self.macro_boxes[slot << 3 | octant as usize])),
         }
     }
 
@@ -327,13 +331,9 @@ impl CellIndex {
         }
         let r = resolution.as_ivec3();
         let counts = BoxCounts::new(r, |c| matches!(self.lookup(c, 0), Lookup::Blocks(_)));
-        for (c, word, entries) in self.macrocells() {
-            if word & OCCUPIED != 0 {
-                if self.records[(word & !OCCUPIED) as usize]
-                    .bits
-                    .iter()
-                    .all(|&b| b == 0)
-                {
+        for (c, record, entries) in self.macrocells() {
+            if let Some(record) = record {
+                if self.records[record].bits.iter().all(|&b| b == 0) {
                     return Err(format!("macrocell {c} has a record but no cell"));
                 }
                 continue;
@@ -345,7 +345,7 @@ impl CellIndex {
                         reach::box_cells(c << MACRO_SHIFT, 1 << MACRO_SHIFT, octant, sides);
                     counts.count(lo, hi) == 0
                 };
-                if word != 0 || sides.min_element() < 1 << MACRO_SHIFT || !empty(sides) {
+                if sides.min_element() < 1 << MACRO_SHIFT || !empty(sides) {
                     return Err(format!(
                         "empty macrocell {c}'s box towards octant {octant} ({sides}) is \
                          smaller than the macrocell or not empty"
