@@ -283,10 +283,10 @@ impl<const FUSED: bool> CellWalk<FUSED> {
         self.leave_box(Vec3A::splat(side), unit_shift)
     }
 
-    /// [`CellWalk::leave_cube`] for a box of `sides` cells along each axis (each at least
+    /// [`CellWalk::leave_cube`] for a box of `reach` cells along each axis (each at least
     /// `2^unit_shift`).
     #[inline(always)]
-    pub fn leave_box(&mut self, sides: Vec3A, unit_shift: u32) -> bool {
+    pub fn leave_box(&mut self, reach: Vec3A, unit_shift: u32) -> bool {
         let unit = (1 << unit_shift) as f32;
         let cell = self.face - self.up;
         // The cube's corner unit, from the integer cell (for cubes of cells, the cell).
@@ -298,7 +298,6 @@ impl<const FUSED: bool> CellWalk<FUSED> {
         // The cube's far faces: `side` cells past `base` upwards, or `side` cells below the
         // unit's top face downwards (`base + unit − side`); within the grid.
         let corner = base + (Vec3A::ONE - self.up) * unit;
-        let reach = sides;
         let far = (self.step_f * reach + corner).clamp(Vec3A::ZERO, self.resolution_f);
         // Where the ray crosses them: `slope·far + offset`, expanded so that the reach,
         // the last value to arrive, enters in one multiply-add (for a cube of cells, the
