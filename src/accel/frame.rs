@@ -158,6 +158,11 @@ impl GridFrame {
     /// [`CellWalk`].
     #[inline(always)]
     pub fn start_walk<const FUSED: bool>(&self, ray: &Ray) -> Option<CellWalk<FUSED>> {
+        #[cfg(target_arch = "x86_64")]
+        debug_assert!(
+            !FUSED || std::is_x86_feature_detected!("fma"),
+            "a fused walk on a processor without FMA"
+        );
         let clip = self.clip(ray)?;
         let (origin, direction, moving) = (clip.origin, clip.direction, clip.moving);
         let lo = Vec3A::from(self.bounds.min);
@@ -413,7 +418,7 @@ fn mul_add<const FUSED: bool>(a: Vec3A, b: Vec3A, c: Vec3A) -> Vec3A {
     if FUSED {
         use std::arch::x86_64::{__m128, _mm_fmadd_ps};
         // SAFETY: `FUSED` is true only in the queries compiled for FMA, which run only on
-        // processors that have it (see above).
+        // processors that have it (see above; debug builds check it in `start_walk`).
         return Vec3A::from(unsafe {
             _mm_fmadd_ps(__m128::from(a), __m128::from(b), __m128::from(c))
         });
