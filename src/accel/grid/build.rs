@@ -142,7 +142,12 @@ impl Grid {
         }
         let CellOrder { counts, sorted } = parts.sort(&chunks, keys);
         drop(chunks);
-        let cells = CellIndex::build(self.frame.resolution, &counts, LANES as u32);
+        let cells = CellIndex::build(
+            self.frame.resolution,
+            &counts,
+            LANES as u32,
+            std::mem::size_of::<Block>(),
+        );
         // Each block's run of the sorted triangle numbers (start, length), in key order as
         // the index numbers them (empty macrocells, most of the grid, are passed over
         // whole).

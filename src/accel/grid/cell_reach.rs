@@ -1,17 +1,28 @@
 //! How far empty space reaches ahead of a ray from each empty cell of an occupied
 //! macrocell: for each of the eight octants of directions, the side (in cells, up to
-//! [`MAX_REACH`]) of the largest cube of empty cells that has the cell as a corner and
-//! extends in that octant's directions — the octant reaches of [`super::reach`], one level
-//! down. Most of a walk's steps are through empty cells of macrocells a surface passes
-//! through; a ray moving into the octant stays in the cube until it crosses one of its far
-//! faces, so the walk leaves the whole cube in one step. Unlike a distance to the nearest
-//! occupied cell (proximity clouds, Cohen & Sheffer 1994, which this replaces), the cube is
-//! bounded only by what lies ahead, not by the surface the ray has just left or passes.
+//! [`MAX_REACH`]) of the largest cube of empty cells that has the cell's *unit* in its
+//! corner and extends in that octant's directions — the octant reaches of
+//! [`super::reach`], one level down. Most of a walk's steps are through empty cells of
+//! macrocells a surface passes through; a ray moving into the octant stays in the cube
+//! until it crosses one of its far faces, so the walk leaves the whole cube in one step.
+//! Unlike a distance to the nearest occupied cell (proximity clouds, Cohen & Sheffer 1994,
+//! which this replaces), the cube is bounded only by what lies ahead, not by the surface
+//! the ray has just left or passes.
+//!
+//! The unit is the cell itself, or for a grid whose blocks are many times the caches a
+//! 2³ unit of cells ([`unit_shift_for`]): an octant's reaches then take 32 bytes (half a
+//! cache line) instead of 256 (four lines), so a ray entering a macrocell asks for one line
+//! of reaches instead of four, and the full dragon's reaches take 0.4 MB instead of 3.5,
+//! which stay in the caches beside the blocks. Its cubes are coarser (a cell in a unit
+//! that holds an occupied cell is left by a plain step): on the full dragon 0.88 the time
+//! of outside rays and 0.93 of bounce rays, but 1.03–1.06 on the 11k dragon, which is in
+//! cache (docs/grid.md, twenty-fifth session).
 //!
 //! Computed per macrocell and octant on rows of bits over the macrocell and its neighbours
 //! towards the octant: the cells whose cube of side k + 1 is empty are those whose cubes of
 //! side k at the cell and at its seven neighbours towards the octant are all empty — three
-//! `and`s per row (along x, then y, then z) per side.
+//! `and`s per row (along x, then y, then z) per side. A 2³ unit's reach is then that of
+//! its cell nearest the octant's origin, whose cubes of two or more cells cover the unit.
 
 use super::cells::MACRO_CELLS;
 use super::reach::moves_up;
@@ -24,28 +35,94 @@ const WINDOW: usize = 3 * SIDE;
 /// macrocell stays within the macrocell and its neighbours towards the octant.
 pub(super) const MAX_REACH: u32 = SIDE as u32;
 
+/// Grids whose blocks take more bytes than this keep reaches per 2³ unit of cells, the
+/// others per cell ([`unit_shift_for`]). Between the 203k dragon's 23 MB of blocks (2³
+/// units: 0.97–1.07 the time of per-cell reaches, mixed) and the full dragon's 88 MB
+/// (0.88–1.00): about where the blocks outgrow a large last-level cache.
+pub const LARGE_BLOCKS: usize = 48 << 20;
+
+/// log2 of a unit's side for a grid whose blocks take `block_bytes`: 0 (a unit is a cell)
+/// or 1 (2³ cells).
+pub(super) fn unit_shift_for(block_bytes: usize) -> u32 {
+    u32::from(block_bytes > LARGE_BLOCKS)
+}
+
+/// Bytes of one octant's reaches of a macrocell's units of 2^`unit_shift` cells a side,
+/// two to a byte.
+#[inline(always)]
+pub(super) fn octant_bytes(unit_shift: u32) -> usize {
+    (MACRO_CELLS >> (3 * unit_shift)) / 2
+}
+
+/// The nibble of cell `l` (its index within the macrocell, x + 8y + 64z) among its
+/// macrocell's units of 2^`unit_shift` cells a side (numbered x fastest).
+#[inline(always)]
+pub(super) fn unit_of(l: usize, unit_shift: u32) -> usize {
+    match unit_shift {
+        0 => l,
+        _ => (l & 7) >> 1 | (l >> 4 & 3) << 2 | (l >> 7 & 3) << 4,
+    }
+}
+
+/// The reach (0 or 2 to [`MAX_REACH`] for units of 2³; 0 to [`MAX_REACH`] for cells) in
+/// nibble `u` of an octant's reaches `bytes`.
+#[inline(always)]
+pub(super) fn nibble(bytes: &[u8], u: usize) -> u32 {
+    u32::from(bytes[u >> 1] >> ((u & 1) * 4)) & 0xf
+}
+
 /// One octant's reach per cell of a macrocell, two to a byte (cell `l` in byte `l / 2`,
 /// the low nibble for even `l`); 0 for an occupied cell.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(C, align(64))]
-pub(super) struct CellReaches([u8; MACRO_CELLS / 2]);
+struct CellReaches([u8; MACRO_CELLS / 2]);
 
-/// Per octant (as [`super::reach::octant`] numbers them), the reaches of a macrocell's
-/// cells.
-pub(super) type OctantReaches = [CellReaches; 8];
+/// The reaches of a macrocell's units of 2^`unit_shift` cells a side, octant by octant
+/// (as [`super::reach::octant`] numbers them; [`octant_bytes`] each), from the occupancy
+/// of it and its neighbours: `neighbour(dx, dy, dz)` (each −1, 0 or 1) gives a neighbour's
+/// occupancy words (bit `x + 8y` of word `z` for its cell (x, y, z)), `None` where it is
+/// empty or outside the grid (outside counts as empty: a ray there has left the grid).
+pub(super) fn reaches(
+    neighbour: impl Fn(i32, i32, i32) -> Option<[u64; SIDE]>,
+    unit_shift: u32,
+) -> Vec<u8> {
+    let cells = CellReaches::of(neighbour);
+    let mut bytes = Vec::with_capacity(8 * octant_bytes(unit_shift));
+    for (octant, cells) in cells.iter().enumerate() {
+        match unit_shift {
+            0 => bytes.extend_from_slice(&cells.0),
+            _ => bytes.extend_from_slice(&cells.units(octant as u32)),
+        }
+    }
+    bytes
+}
 
 impl CellReaches {
     /// The reach of cell `l` (its index within the macrocell).
-    #[inline(always)]
-    pub fn get(&self, l: usize) -> u32 {
-        u32::from(self.0[l >> 1] >> ((l & 1) * 4)) & 0xf
+    fn get(&self, l: usize) -> u32 {
+        nibble(&self.0, l)
     }
 
-    /// The reaches of a macrocell's cells in every octant, from the occupancy of it and its
-    /// neighbours: `neighbour(dx, dy, dz)` (each −1, 0 or 1) gives a neighbour's occupancy
-    /// words (bit `x + 8y` of word `z` for its cell (x, y, z)), `None` where it is empty or
-    /// outside the grid (outside counts as empty: a ray there has left the grid).
-    pub fn of(neighbour: impl Fn(i32, i32, i32) -> Option<[u64; SIDE]>) -> OctantReaches {
+    /// Each 2³ unit's reach towards `octant`: the reach of its cell nearest the octant's
+    /// origin (the cube of two or more cells with that cell in its corner covers the
+    /// unit), if at least 2, else 0.
+    fn units(&self, octant: u32) -> [u8; MACRO_CELLS / 16] {
+        let mut units = [0u8; MACRO_CELLS / 16];
+        let back = |axis: usize| usize::from(!moves_up(octant, axis));
+        for u in 0..MACRO_CELLS / 8 {
+            let (x, y, z) = (
+                2 * (u & 3) + back(0),
+                2 * (u >> 2 & 3) + back(1),
+                2 * (u >> 4) + back(2),
+            );
+            let reach = self.get(x + SIDE * (y + SIDE * z));
+            let reach = if reach >= 2 { reach as u8 } else { 0 };
+            units[u >> 1] |= reach << ((u & 1) * 4);
+        }
+        units
+    }
+
+    /// The reaches of a macrocell's cells in every octant ([`reaches`]).
+    fn of(neighbour: impl Fn(i32, i32, i32) -> Option<[u64; SIDE]>) -> [CellReaches; 8] {
         // Empty cells of the 24³ window as rows along x: empty[z][y], bit x.
         let mut empty = [[(1u32 << WINDOW) - 1; WINDOW]; WINDOW];
         for dz in -1..=1 {
@@ -176,10 +253,11 @@ static SPREAD: [u32; 256] = {
 mod tests {
     use super::*;
 
-    /// Reaches found by trying every side: the largest cube of empty cells with the cell as
-    /// its corner, towards the octant, within the window (outside it counts as empty).
+    /// Reaches found by trying every side: the largest cube of empty cells with the cell (or
+    /// the unit) as its corner, towards the octant, within the window (outside it counts as
+    /// empty).
     #[test]
-    fn reaches_are_the_largest_empty_cube_towards_each_octant() {
+    fn reaches_are_the_largest_empty_cube_towards_each_octant_of_cells_and_units() {
         let mut rng = crate::render::sampling::Rng::new(5, 5);
         let mut coordinate = || (rng.next_u32() % WINDOW as u32) as i32 - SIDE as i32;
         for round in 0..40 {
@@ -200,7 +278,10 @@ mod tests {
                 w.iter().any(|&b| b != 0).then_some(w)
             };
             let reaches = CellReaches::of(words);
+            let (cells, units) = (super::reaches(words, 0), super::reaches(words, 1));
             for (octant, reaches) in reaches.iter().enumerate() {
+                let cells = &cells[octant * octant_bytes(0)..][..octant_bytes(0)];
+                let units = &units[octant * octant_bytes(1)..][..octant_bytes(1)];
                 let s = [0, 1, 2].map(|a| if moves_up(octant as u32, a) { 1 } else { -1 });
                 let cube_is_empty = |c: [i32; 3], k: i32| {
                     !occupied.iter().any(|o| {
@@ -219,6 +300,18 @@ mod tests {
                         reaches.get(l),
                         want,
                         "cell {c:?}, octant {octant}, round {round}"
+                    );
+                    assert_eq!(nibble(cells, unit_of(l, 0)), want);
+                    // The unit's reach: its cell nearest the octant's origin's, from 2.
+                    let back = c.map(|x| x & !1);
+                    let back = [0, 1, 2].map(|a| back[a] + i32::from(s[a] < 0));
+                    let unit = (1..=MAX_REACH as i32)
+                        .take_while(|&k| cube_is_empty(back, k))
+                        .count() as u32;
+                    assert_eq!(
+                        nibble(units, unit_of(l, 1)),
+                        if unit >= 2 { unit } else { 0 },
+                        "cell {c:?}'s unit, octant {octant}, round {round}"
                     );
                 }
             }

@@ -3,10 +3,10 @@
 //! The cells are grouped in macrocells of 8³. One word per macrocell says where its record
 //! is, or that it is empty; for an empty macrocell, a box per octant of directions says how
 //! far empty space reaches from it ([`super::reach`]), so the walk can leap over a whole box
-//! of empty cells. A record holds the 512 occupancy bits of its cells, the ranks, and
-//! for each octant how far empty space reaches from each cell ([`super::cell_reach`]); a
-//! ray entering the macrocell asks for the occupancy, the ranks and its own octant's
-//! reaches at once. Occupied cells are numbered macrocell by macrocell, so an occupied
+//! of empty cells. An occupied macrocell has a record of the 512 occupancy bits of its
+//! cells and the ranks, and beside it, for each octant, how far empty space reaches from
+//! each cell (or 2³ unit of cells, [`super::cell_reach`]); a ray entering the macrocell
+//! asks for the occupancy, the ranks and its own octant's reaches at once. Occupied cells are numbered macrocell by macrocell, so an occupied
 //! cell's number is its word's rank plus a popcount within one 64-bit word, and the offsets
 //! of the cells of one macrocell lie together. A ray stepping through a macrocell thus reads
 //! one record instead of occupancy words scattered over whole rows of the grid.
@@ -17,7 +17,7 @@ use glam::{IVec3, UVec3, Vec3A};
 use rayon::prelude::*;
 
 use super::box_counts::BoxCounts;
-use super::cell_reach::{self, CellReaches, OctantReaches};
+use super::cell_reach;
 use super::reach;
 
 /// A macrocell is 2^MACRO_SHIFT cells along each axis.
@@ -35,16 +35,14 @@ fn record_in(word: u32) -> Option<usize> {
     (word & OCCUPIED != 0).then_some((word & !OCCUPIED) as usize)
 }
 
-/// What the walk needs to know about one occupied macrocell, in one place so that entering
-/// the macrocell can ask for what a ray needs at once: per octant, how far empty space
-/// reaches from each cell (256 bytes, four cache lines, first so that each octant's lines
-/// are whole), the occupancy of its 512 cells (x fastest, then y, then z), and per word of
-/// those bits the number of the word's first occupied cell (so an occupied cell's number is
-/// one popcount away, with no loop over words).
+/// What the walk needs to know about one occupied macrocell besides its reaches, in one
+/// place so that entering the macrocell can ask for it at once: the occupancy of its 512
+/// cells (x fastest, then y, then z), and per word of those bits the number of the word's
+/// first occupied cell (so an occupied cell's number is one popcount away, with no loop
+/// over words). Two cache lines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(C, align(64))]
 struct Record {
-    reaches: OctantReaches,
     bits: [u64; MACRO_CELLS / 64],
     ranks: [u32; MACRO_CELLS / 64],
 }
@@ -55,8 +53,9 @@ pub(super) enum Lookup {
     /// [`CellIndex::macrocell_of`]'s answer).
     EmptyMacrocell,
     /// The cell is empty (its macrocell is not), and so is the cube of `reach` cells a
-    /// side that has it as a corner and extends towards the octant asked about
-    /// ([`super::cell_reach`]).
+    /// side that has the cell's unit ([`CellIndex::unit_shift`]) in its corner and extends
+    /// towards the octant asked about ([`super::cell_reach`]); for units of 2³ cells,
+    /// `reach` is 0 when not even the unit is.
     EmptyCell { reach: u32 },
     /// The cell's blocks.
     Blocks(Range<usize>),
@@ -83,6 +82,13 @@ pub(super) struct CellIndex {
     /// word's, so the two loads overlap.
     macro_boxes: Vec<u32>,
     records: Vec<Record>,
+    /// log2 of the side, in cells, of the units reaches are kept for
+    /// ([`cell_reach::unit_shift_for`]).
+    unit_shift: u32,
+    /// Per record and octant ([`CellIndex::reach_bytes`]), the reaches of the macrocell's
+    /// units, in cache lines: an octant's reaches are whole lines (per cell) or half of one
+    /// (per 2³ unit).
+    reaches: Vec<ReachLine>,
     /// Per record, the number of its first occupied cell (its first rank, kept apart so
     /// that its offsets can be asked for together with the record, before it arrives).
     first_cells: Vec<u32>,
@@ -107,8 +113,13 @@ impl CellIndex {
     }
 
     /// The index of a grid whose cell with storage key `k` holds `triangles[k]` triangles,
-    /// in blocks of `lanes`, laid out in key order.
-    pub fn build(resolution: UVec3, triangles: &[u32], lanes: u32) -> CellIndex {
+    /// in blocks of `lanes` of `block_bytes` each, laid out in key order.
+    pub fn build(
+        resolution: UVec3,
+        triangles: &[u32],
+        lanes: u32,
+        block_bytes: usize,
+    ) -> CellIndex {
         let macro_resolution = CellIndex::macro_resolution_for(resolution);
         let m = macro_resolution;
         let macro_count = (m.x * m.y * m.z) as usize;
@@ -153,18 +164,13 @@ impl CellIndex {
             triangles[CellIndex::storage_key(macro_resolution, c.as_uvec3())] > 0
         });
         index.fill_entries(&cells, &record_of);
-        let reaches = index.cell_reaches_of(&occupancy);
         index.first_cells = ranks.iter().map(|r| r[0]).collect();
         index.records = occupancy
             .into_iter()
             .zip(ranks)
-            .zip(reaches)
-            .map(|((bits, ranks), reaches)| Record {
-                reaches,
-                bits,
-                ranks,
-            })
+            .map(|(bits, ranks)| Record { bits, ranks })
             .collect();
+        index.fill_reaches(cell_reach::unit_shift_for(total as usize * block_bytes));
         index
     }
 
@@ -195,29 +201,54 @@ impl CellIndex {
         })
     }
 
-    /// The cells' reaches ([`CellReaches`]) of each occupied macrocell, given the occupancy
-    /// bits of each, in parallel over them.
-    fn cell_reaches_of(&self, occupancy: &[[u64; MACRO_CELLS / 64]]) -> Vec<OctantReaches> {
+    /// Finds the reaches ([`super::cell_reach`]) of every occupied macrocell's units of
+    /// 2^`unit_shift` cells a side, in parallel over the macrocells, from their occupancy.
+    pub fn fill_reaches(&mut self, unit_shift: u32) {
         let m = self.macro_resolution.as_ivec3();
-        let mut at = vec![IVec3::ZERO; occupancy.len()];
+        let mut at = vec![IVec3::ZERO; self.records.len()];
         for (c, record, _) in self.macrocells() {
             if let Some(record) = record {
                 at[record] = c;
             }
         }
-        let index = self;
-        at.par_iter()
+        let index = &*self;
+        let bytes: Vec<Vec<u8>> = at
+            .par_iter()
             .map(|&c| {
-                CellReaches::of(|dx, dy, dz| {
-                    let n = c + IVec3::new(dx, dy, dz);
-                    if n.cmplt(IVec3::ZERO).any() || n.cmpge(m).any() {
-                        return None;
-                    }
-                    let record = index.macrocell_of(n << MACRO_SHIFT, 0).ok();
-                    record.map(|record| occupancy[record])
-                })
+                cell_reach::reaches(
+                    |dx, dy, dz| {
+                        let n = c + IVec3::new(dx, dy, dz);
+                        if n.cmplt(IVec3::ZERO).any() || n.cmpge(m).any() {
+                            return None;
+                        }
+                        let record = index.macrocell_of(n << MACRO_SHIFT, 0).ok();
+                        record.map(|record| index.records[record].bits)
+                    },
+                    unit_shift,
+                )
             })
-            .collect()
+            .collect();
+        self.unit_shift = unit_shift;
+        self.reaches = bytes
+            .concat()
+            .chunks(64)
+            .map(|line| ReachLine(line.try_into().expect("whole lines")))
+            .collect();
+    }
+
+    /// log2 of the side, in cells, of the units whose reaches the index keeps: the unit
+    /// shift [`crate::accel::frame::CellWalk::leave_cube`] takes.
+    #[inline(always)]
+    pub fn unit_shift(&self) -> u32 {
+        self.unit_shift
+    }
+
+    /// Where record `record`'s reaches towards `octant` begin, in bytes from the start of
+    /// `reaches`, for units of 2^`UNIT` cells (the index's [`CellIndex::unit_shift`]).
+    #[inline(always)]
+    fn reach_bytes<const UNIT: u32>(&self, record: usize, octant: u32) -> usize {
+        debug_assert_eq!(UNIT, self.unit_shift);
+        (record * 8 + octant as usize) * cell_reach::octant_bytes(UNIT)
     }
 
     /// Where macrocell `m`'s word lies: its coordinates' bits side by side, each axis given
@@ -235,7 +266,10 @@ impl CellIndex {
     pub fn lookup(&self, c: IVec3, octant: u32) -> Lookup {
         match self.macrocell_of(c, octant) {
             Err(_) => Lookup::EmptyMacrocell,
-            Ok(record) => self.lookup_in(record, c, octant),
+            Ok(record) => match self.unit_shift {
+                0 => self.lookup_in::<0>(record, c, octant),
+                _ => self.lookup_in::<1>(record, c, octant),
+            },
         }
     }
 
@@ -255,10 +289,14 @@ impl CellIndex {
     /// cells' offsets at once: the walk has just entered its macrocell and will read
     /// several parts of them, one after another.
     #[inline(always)]
-    pub fn prefetch_record(&self, record: usize, octant: u32) {
+    pub fn prefetch_record<const UNIT: u32>(&self, record: usize, octant: u32) {
         use crate::accel::prefetch::prefetch;
         let r = &self.records[record];
-        prefetch(&r.reaches[octant as usize]);
+        let start = self.reach_bytes::<UNIT>(record, octant);
+        let lines = cell_reach::octant_bytes(UNIT).div_ceil(64);
+        for line in &self.reaches[start / 64..][..lines] {
+            prefetch(line);
+        }
         prefetch(&r.bits);
         prefetch(&r.ranks);
         let first = self.first_cells[record] as usize;
@@ -269,14 +307,18 @@ impl CellIndex {
     /// What record `record` says about its cell `c` to a ray moving into `octant`:
     /// `EmptyCell` or `Blocks`.
     #[inline(always)]
-    pub fn lookup_in(&self, record: usize, c: IVec3, octant: u32) -> Lookup {
+    pub fn lookup_in<const UNIT: u32>(&self, record: usize, c: IVec3, octant: u32) -> Lookup {
         let l = local_index(c & IVec3::splat((1 << MACRO_SHIFT) - 1));
+        let at = self.reach_bytes::<UNIT>(record, octant);
         let record = &self.records[record];
         let bits = record.bits[l >> 6];
         let bit = 1u64 << (l & 63);
         if bits & bit == 0 {
+            let u = cell_reach::unit_of(l, UNIT);
+            let at = at + (u >> 1);
+            let byte = self.reaches[at / 64].0[at % 64];
             return Lookup::EmptyCell {
-                reach: record.reaches[octant as usize].get(l),
+                reach: cell_reach::nibble(&[byte], u & 1),
             };
         }
         let k = (record.ranks[l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
@@ -298,6 +340,7 @@ impl CellIndex {
         std::mem::size_of_val(self.macro_words.as_slice())
             + std::mem::size_of_val(self.macro_boxes.as_slice())
             + std::mem::size_of_val(self.records.as_slice())
+            + std::mem::size_of_val(self.reaches.as_slice())
             + std::mem::size_of_val(self.first_cells.as_slice())
             + std::mem::size_of_val(self.offsets.as_slice())
     }
@@ -368,9 +411,9 @@ impl CellIndex {
 }
 
 impl CellIndex {
-    /// Checks every stored cell reach against a count of occupied cells in boxes
+    /// Checks every stored unit reach against a count of occupied cells in boxes
     /// ([`BoxCounts`]): the cube it promises holds none, and (below the cap) the cube one
-    /// cell larger holds one.
+    /// cell larger holds one; a reach of 0, that the unit's cube of 2 holds one.
     fn validate_cell_reaches(&self, r: IVec3, counts: &BoxCounts) -> Result<(), String> {
         for z in 0..r.z {
             for y in 0..r.y {
@@ -380,8 +423,21 @@ impl CellIndex {
                         let Lookup::EmptyCell { reach: k } = self.lookup(c, octant) else {
                             continue;
                         };
-                        check_reach(counts, c, octant, k, cell_reach::MAX_REACH)
-                            .map_err(|e| format!("cell {e}"))?;
+                        let shift = self.unit_shift;
+                        let (unit, side) = (c >> shift << shift, 1 << shift);
+                        // A unit of 2³ may reach 0: its own cube holds an occupied cell.
+                        if k == 0 && shift != 0 {
+                            let (lo, hi) = reach::cube_box(unit, side, octant, side);
+                            if counts.count(lo, hi) == 0 {
+                                return Err(format!(
+                                    "cell {c}'s unit reaches 0 towards octant {octant}, but \
+                                     its cube of {side} is empty"
+                                ));
+                            }
+                            continue;
+                        }
+                        check_reach(counts, unit, side, octant, k, cell_reach::MAX_REACH)
+                            .map_err(|e| format!("the unit at cell {e}"))?;
                     }
                 }
             }
@@ -390,16 +446,24 @@ impl CellIndex {
     }
 }
 
-/// Checks a reach `k` of cell `c` towards `octant` ([`cell_reach`]): the cube it promises
-/// holds no occupied cell of `counts`, and — below `cap` — the cube one larger does.
-fn check_reach(counts: &BoxCounts, c: IVec3, octant: u32, k: u32, cap: u32) -> Result<(), String> {
-    let (lo, hi) = reach::cube_box(c, 1, octant, k as i32);
+/// Checks a reach `k` towards `octant` of the unit of `unit` cells a side at cell `c`
+/// ([`cell_reach`]): the cube it promises holds no occupied cell of `counts`, and — below
+/// `cap` — the cube one larger does.
+fn check_reach(
+    counts: &BoxCounts,
+    c: IVec3,
+    unit: i32,
+    octant: u32,
+    k: u32,
+    cap: u32,
+) -> Result<(), String> {
+    let (lo, hi) = reach::cube_box(c, unit, octant, k as i32);
     if k < 1 || counts.count(lo, hi) != 0 {
         return Err(format!(
             "{c} reaches {k} towards octant {octant}, past an occupied one"
         ));
     }
-    let (lo, hi) = reach::cube_box(c, 1, octant, k as i32 + 1);
+    let (lo, hi) = reach::cube_box(c, unit, octant, k as i32 + 1);
     if k < cap && counts.count(lo, hi) == 0 {
         return Err(format!("{c} reaches only {k} towards octant {octant}"));
     }
@@ -439,3 +503,9 @@ fn dense_coordinates(r: UVec3, mi: usize) -> IVec3 {
 fn local_index(l: IVec3) -> usize {
     (l.x + (l.y << MACRO_SHIFT) + (l.z << (2 * MACRO_SHIFT))) as usize
 }
+
+/// A cache line of reaches ([`CellIndex::reaches`]), aligned so that one octant's reaches
+/// never straddle more lines than they fill.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(64))]
+struct ReachLine([u8; 64]);

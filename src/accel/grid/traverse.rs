@@ -1,8 +1,9 @@
 //! Ray traversal: the 3D-DDA of Amanatides & Woo (1987), "A fast voxel traversal algorithm
 //! for ray tracing", over the two-level cell index ([`super::cells`]): an empty macrocell
 //! sends the walk past the whole empty box ahead of it in one step ([`super::reach`]), an
-//! empty cell past the empty cube ahead of it if that is two or more cells a side
-//! ([`super::cell_reach`]), any other empty cell costs a bit test and a step, and an
+//! empty cell past the empty cube ahead of it (or of its 2³ unit of cells) if that is two
+//! or more cells a side ([`super::cell_reach`]), any other empty cell costs a bit test and
+//! a step, and an
 //! occupied cell's blocks are tested eight triangles at a time. A grid of one cell is not
 //! walked: its blocks are tested at once.
 
@@ -111,35 +112,59 @@ impl Grid {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
+        match self.cells.unit_shift() {
+            0 => self.intersect_at::<0>(ray, stats),
+            _ => self.intersect_at::<1>(ray, stats),
+        }
+    }
+
+    /// [`Grid::intersect_counting`] for a grid whose reaches are kept per unit of
+    /// 2^`UNIT` cells ([`super::cell_reach`]): each unit's walk compiled in functions of
+    /// its own, so that neither pays for the other's code (in one function, the 11k
+    /// dragon's queries took 1.01–1.03 the time).
+    #[inline(always)]
+    fn intersect_at<const UNIT: u32>(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> Option<GridHit> {
         // SAFETY (each arm): the processor has the features enabled in the version called,
         // as `x86_level` found.
         #[cfg(target_arch = "x86_64")]
         match x86_level() {
-            X86Level::Avx512 => return unsafe { self.intersect_avx512(ray, stats) },
-            X86Level::Avx2 => return unsafe { self.intersect_avx2(ray, stats) },
+            X86Level::Avx512 => return unsafe { self.intersect_avx512::<UNIT>(ray, stats) },
+            X86Level::Avx2 => return unsafe { self.intersect_avx2::<UNIT>(ray, stats) },
             X86Level::Baseline => {}
         }
-        self.intersect_portable::<false>(ray, stats)
+        self.intersect_portable::<false, UNIT>(ray, stats)
     }
 
     /// [`Grid::intersect_portable`] compiled for AVX2, where a block's eight lanes are one
     /// vector (the arithmetic, and so the answer, is the same).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
-    fn intersect_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
-        self.intersect_portable::<true>(ray, stats)
+    fn intersect_avx2<const UNIT: u32>(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> Option<GridHit> {
+        self.intersect_portable::<true, UNIT>(ray, stats)
     }
 
     /// [`Grid::intersect_portable`] compiled for AVX-512 ([`X86Level::Avx512`]; the same
     /// arithmetic).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
-    fn intersect_avx512(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
-        self.intersect_portable::<true>(ray, stats)
+    fn intersect_avx512<const UNIT: u32>(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> Option<GridHit> {
+        self.intersect_portable::<true, UNIT>(ray, stats)
     }
 
     #[inline(always)]
-    fn intersect_portable<const FUSED: bool>(
+    fn intersect_portable<const FUSED: bool, const UNIT: u32>(
         &self,
         ray: &Ray,
         stats: &mut impl TraversalStats,
@@ -148,7 +173,7 @@ impl Grid {
         // within the cell being visited, since every later cell lies beyond that cell.
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
-        let mut cells = self.occupied_cells::<true, FUSED>(ray);
+        let mut cells = self.occupied_cells::<true, FUSED, UNIT>(ray);
         while let Some((range, limit)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
@@ -170,33 +195,42 @@ impl Grid {
     /// cells given out. For the benchmark, to split a query's time between the walk and the
     /// triangles.
     pub fn walk(&self, ray: &Ray, t_stop: f32) -> usize {
+        match self.cells.unit_shift() {
+            0 => self.walk_at::<0>(ray, t_stop),
+            _ => self.walk_at::<1>(ray, t_stop),
+        }
+    }
+
+    /// [`Grid::walk`] for units of 2^`UNIT` cells, as [`Grid::intersect_at`].
+    #[inline(always)]
+    fn walk_at<const UNIT: u32>(&self, ray: &Ray, t_stop: f32) -> usize {
         // SAFETY (each arm): as in `intersect_counting`.
         #[cfg(target_arch = "x86_64")]
         match x86_level() {
-            X86Level::Avx512 => return unsafe { self.walk_avx512(ray, t_stop) },
-            X86Level::Avx2 => return unsafe { self.walk_avx2(ray, t_stop) },
+            X86Level::Avx512 => return unsafe { self.walk_avx512::<UNIT>(ray, t_stop) },
+            X86Level::Avx2 => return unsafe { self.walk_avx2::<UNIT>(ray, t_stop) },
             X86Level::Baseline => {}
         }
-        self.walk_portable::<false>(ray, t_stop)
+        self.walk_portable::<false, UNIT>(ray, t_stop)
     }
 
     /// [`Grid::walk_portable`] compiled for AVX2, like the queries.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
-    fn walk_avx2(&self, ray: &Ray, t_stop: f32) -> usize {
-        self.walk_portable::<true>(ray, t_stop)
+    fn walk_avx2<const UNIT: u32>(&self, ray: &Ray, t_stop: f32) -> usize {
+        self.walk_portable::<true, UNIT>(ray, t_stop)
     }
 
     /// [`Grid::walk_portable`] compiled for AVX-512, like the queries.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
-    fn walk_avx512(&self, ray: &Ray, t_stop: f32) -> usize {
-        self.walk_portable::<true>(ray, t_stop)
+    fn walk_avx512<const UNIT: u32>(&self, ray: &Ray, t_stop: f32) -> usize {
+        self.walk_portable::<true, UNIT>(ray, t_stop)
     }
 
     #[inline(always)]
-    fn walk_portable<const FUSED: bool>(&self, ray: &Ray, t_stop: f32) -> usize {
-        let mut cells = self.occupied_cells::<false, FUSED>(ray);
+    fn walk_portable<const FUSED: bool, const UNIT: u32>(&self, ray: &Ray, t_stop: f32) -> usize {
+        let mut cells = self.occupied_cells::<false, FUSED, UNIT>(ray);
         let mut visited = 0;
         while let Some((_, limit)) = cells.next(&mut ()) {
             visited += 1;
@@ -214,28 +248,37 @@ impl Grid {
 
     /// [`Grid::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        match self.cells.unit_shift() {
+            0 => self.occluded_at::<0>(ray, stats),
+            _ => self.occluded_at::<1>(ray, stats),
+        }
+    }
+
+    /// [`Grid::occluded_counting`] for units of 2^`UNIT` cells, as [`Grid::intersect_at`].
+    #[inline(always)]
+    fn occluded_at<const UNIT: u32>(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         // SAFETY (each arm): as in `intersect_counting`.
         #[cfg(target_arch = "x86_64")]
         match x86_level() {
-            X86Level::Avx512 => return unsafe { self.occluded_avx512(ray, stats) },
-            X86Level::Avx2 => return unsafe { self.occluded_avx2(ray, stats) },
+            X86Level::Avx512 => return unsafe { self.occluded_avx512::<UNIT>(ray, stats) },
+            X86Level::Avx2 => return unsafe { self.occluded_avx2::<UNIT>(ray, stats) },
             X86Level::Baseline => {}
         }
-        self.occluded_portable::<false>(ray, stats)
+        self.occluded_portable::<false, UNIT>(ray, stats)
     }
 
     /// [`Grid::occluded_portable`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
-    fn occluded_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.occluded_portable::<true>(ray, stats)
+    fn occluded_avx2<const UNIT: u32>(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        self.occluded_portable::<true, UNIT>(ray, stats)
     }
 
     /// [`Grid::occluded_portable`] compiled for AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
-    fn occluded_avx512(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.occluded_portable::<true>(ray, stats)
+    fn occluded_avx512<const UNIT: u32>(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        self.occluded_portable::<true, UNIT>(ray, stats)
     }
 
     /// The cells are walked from the segment's far end back to its origin (the answer does
@@ -249,7 +292,7 @@ impl Grid {
     /// random lengths 0.81, 0.88 and 1.01; light segments from a camera's hits, each traced
     /// after its camera ray (set `seen`), 0.94 on the full dragon and 1.00 on the 11k.
     #[inline(always)]
-    fn occluded_portable<const FUSED: bool>(
+    fn occluded_portable<const FUSED: bool, const UNIT: u32>(
         &self,
         ray: &Ray,
         stats: &mut impl TraversalStats,
@@ -258,7 +301,7 @@ impl Grid {
             UVec3::ONE => *ray,
             _ => self.frame.reversed(ray).unwrap_or(*ray),
         };
-        let mut cells = self.occupied_cells::<true, FUSED>(&walked);
+        let mut cells = self.occupied_cells::<true, FUSED, UNIT>(&walked);
         while let Some((range, _)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
@@ -272,10 +315,10 @@ impl Grid {
 
     /// The occupied cells along `ray`, front to back.
     #[inline(always)]
-    fn occupied_cells<'a, const READ_BLOCKS: bool, const FUSED: bool>(
+    fn occupied_cells<'a, const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32>(
         &'a self,
         ray: &Ray,
-    ) -> OccupiedCells<'a, READ_BLOCKS, FUSED> {
+    ) -> OccupiedCells<'a, READ_BLOCKS, FUSED, UNIT> {
         let single_cell = self.frame.resolution == UVec3::ONE;
         let walk = if self.blocks.is_empty() || single_cell {
             None
@@ -296,8 +339,9 @@ impl Grid {
 
 /// The occupied cells along a ray, front to back (a cursor rather than an iterator, so the
 /// caller's statistics can ride along). Unless `READ_BLOCKS`, the cells' blocks are not
-/// asked for ahead of time ([`Grid::walk`]). `FUSED` as in [`CellWalk`].
-struct OccupiedCells<'a, const READ_BLOCKS: bool, const FUSED: bool> {
+/// asked for ahead of time ([`Grid::walk`]). `FUSED` as in [`CellWalk`]; `UNIT` the grid's
+/// [`super::cells::CellIndex::unit_shift`].
+struct OccupiedCells<'a, const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32> {
     grid: &'a Grid,
     /// `None` once the ray has left the grid.
     walk: Option<CellWalk<FUSED>>,
@@ -338,7 +382,9 @@ impl Ahead {
 /// belongs to it (the last cell takes all up to the grid's end).
 type Found = (Range<usize>, f32);
 
-impl<const READ_BLOCKS: bool, const FUSED: bool> OccupiedCells<'_, READ_BLOCKS, FUSED> {
+impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32>
+    OccupiedCells<'_, READ_BLOCKS, FUSED, UNIT>
+{
     /// The next occupied cell along the ray.
     ///
     /// The walk runs one occupied cell ahead of the cell given out. Reading a cell's
@@ -389,7 +435,7 @@ impl<const READ_BLOCKS: bool, const FUSED: bool> OccupiedCells<'_, READ_BLOCKS, 
             if let (true, Ok(record)) = (pause, word)
                 && record != self.last_record
             {
-                grid.cells.prefetch_record(record, self.octant);
+                grid.cells.prefetch_record::<UNIT>(record, self.octant);
                 stats.pause_ahead();
                 return Ahead::Paused;
             }
@@ -397,7 +443,7 @@ impl<const READ_BLOCKS: bool, const FUSED: bool> OccupiedCells<'_, READ_BLOCKS, 
             let record = match word {
                 Ok(record) => {
                     stats.enter_macrocell();
-                    grid.cells.prefetch_record(record, self.octant);
+                    grid.cells.prefetch_record::<UNIT>(record, self.octant);
                     record
                 }
                 Err(sides) => {
@@ -415,14 +461,18 @@ impl<const READ_BLOCKS: bool, const FUSED: bool> OccupiedCells<'_, READ_BLOCKS, 
             // leaves it: no macrocell lookup per cell.
             let macrocell = walk.cell() >> MACRO_SHIFT;
             loop {
-                match grid.cells.lookup_in(record, walk.cell(), self.octant) {
-                    // A cell whose reach is 1 is left by an ordinary step: cheaper than
-                    // leaving a cube of one cell.
+                match grid
+                    .cells
+                    .lookup_in::<UNIT>(record, walk.cell(), self.octant)
+                {
+                    // A cell whose reach is 1 is left by an ordinary step, cheaper than
+                    // leaving a cube of one cell; so is one whose 2³ unit has no empty
+                    // cube ahead (reach 0).
                     Lookup::EmptyCell { reach } if reach >= 2 => {
                         stats.leap_cells();
                         // Past the empty cube of `reach` cells ahead
                         // ([`super::cell_reach`]).
-                        if !walk.leave_cube(reach as f32, 0) {
+                        if !walk.leave_cube(reach as f32, UNIT) {
                             self.walk = None;
                             return Ahead::Found(None);
                         }
@@ -644,27 +694,65 @@ mod tests {
             let direction = Vec3::new(u(), u(), u()).normalize();
             let mut ray = Ray::new(origin, direction);
             let fast = grid.intersect(&ray);
-            let portable = grid.intersect_portable::<false>(&ray, &mut ());
+            let portable = grid.intersect_portable::<false, 0>(&ray, &mut ());
             assert_eq!(fast, portable, "ray {k}: {ray:?}");
             // On a processor with AVX-512, the AVX2 version too.
             #[cfg(target_arch = "x86_64")]
             if x86_level() >= X86Level::Avx2 {
                 // SAFETY: the processor has AVX2 and the rest, as `x86_level` found.
-                let avx2 = unsafe { grid.intersect_avx2(&ray, &mut ()) };
+                let avx2 = unsafe { grid.intersect_avx2::<0>(&ray, &mut ()) };
                 assert_eq!(avx2, portable, "ray {k}: {ray:?}");
             }
             hits += usize::from(fast.is_some());
             ray.t_max = 1.5;
-            let blocked = grid.occluded_portable::<false>(&ray, &mut ());
+            let blocked = grid.occluded_portable::<false, 0>(&ray, &mut ());
             assert_eq!(grid.occluded(&ray), blocked, "ray {k}: {ray:?}");
             #[cfg(target_arch = "x86_64")]
             if x86_level() >= X86Level::Avx2 {
                 // SAFETY: as above.
-                let avx2 = unsafe { grid.occluded_avx2(&ray, &mut ()) };
+                let avx2 = unsafe { grid.occluded_avx2::<0>(&ray, &mut ()) };
                 assert_eq!(avx2, blocked, "ray {k}: {ray:?}");
             }
         }
         assert!(hits > 5_000, "{hits} hits");
+    }
+
+    /// A grid whose reaches are kept per 2³ unit of cells (as a grid whose blocks outgrow
+    /// the caches keeps them, [`super::super::cell_reach::unit_shift_for`]) is valid and
+    /// finds, by other steps, exactly what the same grid with reaches per cell finds, for
+    /// rays from outside and from among the cells, and the same shadow answers.
+    #[test]
+    fn reaches_per_unit_of_cells_find_what_reaches_per_cell_find() {
+        let per_cell = Grid::build(sphere(90));
+        assert_eq!(per_cell.cells.unit_shift(), 0);
+        let mut per_unit = per_cell.clone();
+        per_unit.cells.fill_reaches(1);
+        assert_eq!(per_unit.cells.unit_shift(), 1);
+        per_unit.validate().unwrap();
+        assert!(per_unit.stats().bytes < per_cell.stats().bytes);
+        let mut rng = crate::render::sampling::Rng::new(37, 3);
+        let (mut hits, mut leaps) = (0, [0, 0]);
+        for k in 0..20_000 {
+            let mut u = || rng.uniform() * 2.0 - 1.0;
+            let origin = Vec3::new(u(), u(), u()) * if k % 2 == 0 { 3.0 } else { 0.9 };
+            let mut ray = Ray::new(origin, Vec3::new(u(), u(), u()).normalize());
+            let mut counts = [TraversalCounts::default(); 2];
+            let hit = per_cell.intersect_counting(&ray, &mut counts[0]);
+            assert_eq!(
+                per_unit.intersect_counting(&ray, &mut counts[1]),
+                hit,
+                "ray {k}"
+            );
+            hits += usize::from(hit.is_some());
+            for (leaps, counts) in leaps.iter_mut().zip(counts) {
+                *leaps += counts.cell_leaps;
+            }
+            ray.t_max = 1.5;
+            assert_eq!(per_unit.occluded(&ray), per_cell.occluded(&ray), "ray {k}");
+        }
+        assert!(hits > 5_000, "{hits} hits");
+        // Both walks leave cubes of cells.
+        assert!(leaps.iter().all(|&n| n > 1_000), "{leaps:?}");
     }
 
     /// A ray whose direction is tiny (as a ray carried into the space of a hugely scaled
