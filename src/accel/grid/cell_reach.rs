@@ -12,11 +12,12 @@
 //! The unit is the cell itself, or for a grid whose blocks are many times the caches a
 //! 2³ unit of cells ([`unit_shift_for`]): an octant's reaches then take 32 bytes (half a
 //! cache line) instead of 256 (four lines), so a ray entering a macrocell asks for one line
-//! of reaches instead of four, and the full dragon's reaches take 0.4 MB instead of 3.5,
+//! of reaches instead of four, and the full dragon's reaches take 0.4 MB instead of 3.0,
 //! which stay in the caches beside the blocks. Its cubes are coarser (a cell in a unit
-//! that holds an occupied cell is left by a plain step): on the full dragon 0.88 the time
-//! of outside rays and 0.93 of bounce rays, but 1.03–1.06 on the 11k dragon, which is in
-//! cache (docs/grid.md, twenty-fifth session).
+//! that holds an occupied cell is left by a plain step): on the full dragon 0.94–0.95 the
+//! time of outside, bounce and shadow rays, 1.04 of camera rays (whose reaches are in
+//! cache), and on the 11k dragon, which is all in cache, 1.03–1.06 (docs/grid.md,
+//! twenty-fifth session).
 //!
 //! Computed per macrocell and octant on rows of bits over the macrocell and its neighbours
 //! towards the octant: the cells whose cube of side k + 1 is empty are those whose cubes of
@@ -38,8 +39,9 @@ pub(super) const MAX_REACH: u32 = SIDE as u32;
 /// Grids whose blocks take more bytes than this keep reaches per 2³ unit of cells, the
 /// others per cell ([`unit_shift_for`]). Between the 203k dragon's 23 MB of blocks (2³
 /// units: 0.97–1.07 the time of per-cell reaches, mixed) and the full dragon's 88 MB
-/// (0.88–1.00): about where the blocks outgrow a large last-level cache.
-pub const LARGE_BLOCKS: usize = 48 << 20;
+/// (0.94–0.95 on outside, bounce and shadow rays, 1.04 on camera rays): about where the
+/// blocks outgrow a large last-level cache.
+pub(super) const LARGE_BLOCKS: usize = 48 << 20;
 
 /// log2 of a unit's side for a grid whose blocks take `block_bytes`: 0 (a unit is a cell)
 /// or 1 (2³ cells).
