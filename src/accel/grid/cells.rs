@@ -6,8 +6,9 @@
 //! of empty cells. An occupied macrocell has a record of the 512 occupancy bits of its
 //! cells and the ranks, and beside it, for each octant, how far empty space reaches from
 //! each cell (or 2³ unit of cells, [`super::cell_reach`]); a ray entering the macrocell
-//! asks for the occupancy, the ranks and its own octant's reaches at once. Occupied cells are numbered macrocell by macrocell, so an occupied
-//! cell's number is its word's rank plus a popcount within one 64-bit word, and the offsets
+//! asks for the occupancy, the ranks and its own octant's reaches at once. Occupied cells
+//! are numbered macrocell by macrocell, so an occupied cell's number is its word's rank
+//! plus a popcount within one 64-bit word, and the offsets
 //! of the cells of one macrocell lie together. A ray stepping through a macrocell thus reads
 //! one record instead of occupancy words scattered over whole rows of the grid.
 

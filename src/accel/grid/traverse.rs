@@ -743,12 +743,18 @@ mod tests {
                 hit,
                 "ray {k}"
             );
+            // The portable walk of units too (the query above ran the fast one).
+            let portable = per_unit.intersect_portable::<false, 1>(&ray, &mut ());
+            assert_eq!(portable, hit, "ray {k}");
             hits += usize::from(hit.is_some());
             for (leaps, counts) in leaps.iter_mut().zip(counts) {
                 *leaps += counts.cell_leaps;
             }
             ray.t_max = 1.5;
-            assert_eq!(per_unit.occluded(&ray), per_cell.occluded(&ray), "ray {k}");
+            let blocked = per_cell.occluded(&ray);
+            assert_eq!(per_unit.occluded(&ray), blocked, "ray {k}");
+            let portable = per_unit.occluded_portable::<false, 1>(&ray, &mut ());
+            assert_eq!(portable, blocked, "ray {k}");
         }
         assert!(hits > 5_000, "{hits} hits");
         // Both walks leave cubes of cells.
