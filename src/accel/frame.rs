@@ -372,6 +372,26 @@ impl<const FUSED: bool> CellWalk<FUSED> {
         (t_exit.x, true)
     }
 
+    /// True unless the ray, before its end, passes the box of the current cell from
+    /// `lo·step − margin` to `hi·step + margin`, in cells from the cell's lower corner (a
+    /// slab test, Kay & Kajiya 1986, on the walk's face distances: the box's faces are
+    /// crossed at `slope·(cell + lo·step − margin) + offset`). An axis the ray is parallel
+    /// to does not bound it.
+    #[inline(always)]
+    pub fn meets_box(&self, lo: Vec3A, hi: Vec3A, step: f32, margin: Vec3A) -> bool {
+        let cell = self.face - self.up;
+        let step = Vec3A::splat(step);
+        let lo = mul_add::<FUSED>(lo, step, cell - margin);
+        let hi = mul_add::<FUSED>(hi, step, cell + margin);
+        let t_lo = mul_add::<FUSED>(self.slope, lo, self.offset);
+        let t_hi = mul_add::<FUSED>(self.slope, hi, self.offset);
+        let moving = self.slope.cmpne(Vec3A::ZERO);
+        let near = Vec3A::select(moving, t_lo.min(t_hi), Vec3A::NEG_INFINITY).max_element();
+        let far = Vec3A::select(moving, t_lo.max(t_hi), Vec3A::INFINITY).min_element();
+        // Written so that a NaN distance counts as meeting the box.
+        !(near > far || near > self.t_end)
+    }
+
     /// The current cell.
     #[inline(always)]
     pub fn cell(&self) -> IVec3 {

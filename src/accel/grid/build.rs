@@ -8,7 +8,7 @@ use super::cell_order::{Buckets, CellOrder, KeyParts};
 use super::cells::{CellIndex, MACRO_CELLS};
 use super::mesh_triangles::MeshTriangles;
 use super::overlap::{Polygon, TriangleBoxTest};
-use super::{Grid, density};
+use super::{Grid, cell_box, density};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::cpu::x86_fast_path;
 use crate::accel::frame::{GridFrame, padded, resolution};
@@ -180,7 +180,35 @@ impl Grid {
         self.cells = cells;
         self.blocks = blocks;
         self.references = references;
+        self.fill_cell_boxes();
         true
+    }
+
+    /// Per occupied cell, the box of its triangles within it ([`cell_box`]), if the grid
+    /// keeps boxes.
+    fn fill_cell_boxes(&mut self) {
+        let bytes = std::mem::size_of_val(self.blocks.as_slice());
+        if let Some(margin) =
+            cell_box::margin_for(&self.frame).filter(|_| cell_box::boxed_for(bytes))
+        {
+            let boxes = self.cell_boxes();
+            self.cells.set_cell_boxes(boxes, margin);
+        }
+    }
+
+    /// Every occupied cell's box word, in the order the cells are numbered.
+    pub(super) fn cell_boxes(&self) -> Vec<u32> {
+        let cells = self.cells.occupied_cells();
+        cells
+            .par_iter()
+            .enumerate()
+            .map(|(k, &c)| {
+                let stored = self.blocks[self.cells.blocks_of(k)]
+                    .iter()
+                    .flat_map(|block| (0..LANES).filter_map(|lane| block.get(lane)));
+                cell_box::of_cell(&self.frame, c, stored.map(|(triangle, _)| triangle))
+            })
+            .collect()
     }
 
     /// The (cell, triangle) pairs of the live triangles numbered in `chunk`, in triangle

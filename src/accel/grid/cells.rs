@@ -58,8 +58,8 @@ pub(super) enum Lookup {
     /// towards the octant asked about ([`super::cell_reach`]); for units of 2³ cells,
     /// `reach` is 0 when not even the unit is.
     EmptyCell { reach: u32 },
-    /// The cell's blocks.
-    Blocks(Range<usize>),
+    /// The cell's blocks, and the cell's number among the occupied cells.
+    Blocks(Range<usize>, usize),
 }
 
 /// The two-level index of a grid's occupied cells.
@@ -95,6 +95,12 @@ pub(super) struct CellIndex {
     first_cells: Vec<u32>,
     /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes the blocks.
     offsets: Vec<u32>,
+    /// For the k-th occupied cell, the word of its triangles' box within it
+    /// ([`super::cell_box`]); empty for a grid that keeps no boxes.
+    cell_boxes: Vec<u32>,
+    /// How far the walk grows each box ([`super::cell_box::margin_for`]); `None` for a grid that
+    /// keeps no boxes.
+    box_margin: Option<Vec3A>,
 }
 
 impl CellIndex {
@@ -290,7 +296,7 @@ impl CellIndex {
     /// cells' offsets at once: the walk has just entered its macrocell and will read
     /// several parts of them, one after another.
     #[inline(always)]
-    pub fn prefetch_record<const UNIT: u32>(&self, record: usize, octant: u32) {
+    pub fn prefetch_record<const UNIT: u32, const BOXED: bool>(&self, record: usize, octant: u32) {
         use crate::accel::prefetch::prefetch;
         let r = &self.records[record];
         let start = self.reach_bytes::<UNIT>(record, octant);
@@ -303,6 +309,10 @@ impl CellIndex {
         let first = self.first_cells[record] as usize;
         prefetch(&self.offsets[first]);
         prefetch(&self.offsets[(first + 16).min(self.offsets.len() - 1)]);
+        if BOXED {
+            prefetch(&self.cell_boxes[first]);
+            prefetch(&self.cell_boxes[(first + 16).min(self.cell_boxes.len() - 1)]);
+        }
     }
 
     /// What record `record` says about its cell `c` to a ray moving into `octant`:
@@ -323,7 +333,50 @@ impl CellIndex {
             };
         }
         let k = (record.ranks[l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
-        Lookup::Blocks(self.offsets[k] as usize..self.offsets[k + 1] as usize)
+        Lookup::Blocks(self.offsets[k] as usize..self.offsets[k + 1] as usize, k)
+    }
+
+    /// The occupied cells' coordinates, in the order they are numbered.
+    pub fn occupied_cells(&self) -> Vec<IVec3> {
+        let mut cells = Vec::with_capacity(self.occupied());
+        for (m, record, _) in self.macrocells() {
+            if let Some(record) = record {
+                let bits = self.records[record].bits;
+                for l in 0..MACRO_CELLS {
+                    if bits[l >> 6] >> (l & 63) & 1 != 0 {
+                        let l = l as i32;
+                        let local = IVec3::new(l & 7, l >> 3 & 7, l >> 6);
+                        cells.push((m << MACRO_SHIFT) + local);
+                    }
+                }
+            }
+        }
+        cells
+    }
+
+    /// How far the walk grows each cell's box, for a grid that keeps boxes.
+    #[inline(always)]
+    pub fn box_margin(&self) -> Option<Vec3A> {
+        self.box_margin
+    }
+
+    /// The box word of the `k`-th occupied cell, in a grid that keeps boxes.
+    #[inline(always)]
+    pub fn cell_box(&self, k: usize) -> u32 {
+        self.cell_boxes[k]
+    }
+
+    /// The blocks of the `k`-th occupied cell.
+    pub fn blocks_of(&self, k: usize) -> Range<usize> {
+        self.offsets[k] as usize..self.offsets[k + 1] as usize
+    }
+
+    /// Sets the occupied cells' box words ([`super::cell_box`]), in the order the cells are
+    /// numbered, and the margin the walk grows them by.
+    pub fn set_cell_boxes(&mut self, boxes: Vec<u32>, margin: Vec3A) {
+        assert_eq!(boxes.len(), self.occupied());
+        self.box_margin = Some(margin);
+        self.cell_boxes = boxes;
     }
 
     /// Occupied cells.
@@ -344,6 +397,7 @@ impl CellIndex {
             + std::mem::size_of_val(self.reaches.as_slice())
             + std::mem::size_of_val(self.first_cells.as_slice())
             + std::mem::size_of_val(self.offsets.as_slice())
+            + std::mem::size_of_val(self.cell_boxes.as_slice())
     }
 
     /// Checks the index's invariants for a grid of `resolution` cells; returns a description
@@ -364,6 +418,14 @@ impl CellIndex {
         if counted as usize != self.occupied() {
             return Err("records and offsets disagree".into());
         }
+        let boxes = if self.box_margin.is_some() {
+            self.occupied()
+        } else {
+            0
+        };
+        if self.cell_boxes.len() != boxes {
+            return Err(format!("{} cell boxes for {boxes}", self.cell_boxes.len()));
+        }
         if self.first_cells.len() != self.records.len()
             || self
                 .first_cells
@@ -374,7 +436,7 @@ impl CellIndex {
             return Err("a record's first cell is not its first rank".into());
         }
         let r = resolution.as_ivec3();
-        let counts = BoxCounts::new(r, |c| matches!(self.lookup(c, 0), Lookup::Blocks(_)));
+        let counts = BoxCounts::new(r, |c| matches!(self.lookup(c, 0), Lookup::Blocks(..)));
         for (c, record, entries) in self.macrocells() {
             if let Some(record) = record {
                 if self.records[record].bits.iter().all(|&b| b == 0) {

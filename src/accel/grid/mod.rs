@@ -15,11 +15,13 @@
 mod block;
 mod box_counts;
 mod build;
+mod cell_box;
 mod cell_order;
 mod cell_reach;
 mod cells;
 pub mod density;
 mod mesh_triangles;
+mod occupied;
 mod overlap;
 mod reach;
 mod traverse;
@@ -140,9 +142,10 @@ impl Grid {
             for y in 0..self.frame.resolution.y {
                 for x in 0..self.frame.resolution.x {
                     let c = UVec3::new(x, y, z);
-                    let Lookup::Blocks(range) = self.cells.lookup(c.as_ivec3(), 0) else {
+                    let Lookup::Blocks(range, k) = self.cells.lookup(c.as_ivec3(), 0) else {
                         continue;
                     };
+                    let boxed = self.cells.box_margin().map(|m| (self.cells.cell_box(k), m));
                     let lo = self.frame.bounds.min + c.as_vec3() * self.frame.cell_size;
                     let cell = Aabb {
                         min: lo - self.frame.cell_size * 1e-3,
@@ -163,6 +166,11 @@ impl Grid {
                             return Err(format!(
                                 "triangle {id} is stored in cell {c}, which it does not touch"
                             ));
+                        }
+                        if let Some((word, margin)) = boxed
+                            && !cell_box::holds(&self.frame, c.as_ivec3(), word, margin, &triangle)
+                        {
+                            return Err(format!("cell {c}'s box does not hold triangle {id}"));
                         }
                         seen[id] = true;
                     }

@@ -7,18 +7,12 @@
 //! occupied cell's blocks are tested eight triangles at a time. A grid of one cell is not
 //! walked: its blocks are tested at once.
 
-use std::ops::Range;
-
 use glam::UVec3;
 
-use super::cells::{Lookup, MACRO_SHIFT};
-use super::reach;
 use super::{Grid, GridHit};
 use crate::accel::Ray;
 #[cfg(target_arch = "x86_64")]
 use crate::accel::cpu::{X86Level, x86_level};
-use crate::accel::frame::CellWalk;
-use crate::accel::prefetch::prefetch;
 
 /// Counts the work a traversal does, for the benchmark's statistics. The unit type counts
 /// nothing and compiles away.
@@ -112,9 +106,11 @@ impl Grid {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
-        match self.cells.unit_shift() {
-            0 => self.intersect_at::<0>(ray, stats),
-            _ => self.intersect_at::<1>(ray, stats),
+        match (self.cells.unit_shift(), self.cells.box_margin().is_some()) {
+            (0, false) => self.intersect_at::<0, false>(ray, stats),
+            (0, true) => self.intersect_at::<0, true>(ray, stats),
+            (_, false) => self.intersect_at::<1, false>(ray, stats),
+            (_, true) => self.intersect_at::<1, true>(ray, stats),
         }
     }
 
@@ -123,7 +119,7 @@ impl Grid {
     /// its own, so that neither pays for the other's code (in one function, the 11k
     /// dragon's queries took 1.01–1.03 the time).
     #[inline(always)]
-    fn intersect_at<const UNIT: u32>(
+    fn intersect_at<const UNIT: u32, const BOXED: bool>(
         &self,
         ray: &Ray,
         stats: &mut impl TraversalStats,
@@ -132,39 +128,39 @@ impl Grid {
         // as `x86_level` found.
         #[cfg(target_arch = "x86_64")]
         match x86_level() {
-            X86Level::Avx512 => return unsafe { self.intersect_avx512::<UNIT>(ray, stats) },
-            X86Level::Avx2 => return unsafe { self.intersect_avx2::<UNIT>(ray, stats) },
+            X86Level::Avx512 => return unsafe { self.intersect_avx512::<UNIT, BOXED>(ray, stats) },
+            X86Level::Avx2 => return unsafe { self.intersect_avx2::<UNIT, BOXED>(ray, stats) },
             X86Level::Baseline => {}
         }
-        self.intersect_portable::<false, UNIT>(ray, stats)
+        self.intersect_portable::<false, UNIT, BOXED>(ray, stats)
     }
 
     /// [`Grid::intersect_portable`] compiled for AVX2, where a block's eight lanes are one
     /// vector (the arithmetic, and so the answer, is the same).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
-    fn intersect_avx2<const UNIT: u32>(
+    fn intersect_avx2<const UNIT: u32, const BOXED: bool>(
         &self,
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
-        self.intersect_portable::<true, UNIT>(ray, stats)
+        self.intersect_portable::<true, UNIT, BOXED>(ray, stats)
     }
 
     /// [`Grid::intersect_portable`] compiled for AVX-512 ([`X86Level::Avx512`]; the same
     /// arithmetic).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
-    fn intersect_avx512<const UNIT: u32>(
+    fn intersect_avx512<const UNIT: u32, const BOXED: bool>(
         &self,
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
-        self.intersect_portable::<true, UNIT>(ray, stats)
+        self.intersect_portable::<true, UNIT, BOXED>(ray, stats)
     }
 
     #[inline(always)]
-    fn intersect_portable<const FUSED: bool, const UNIT: u32>(
+    fn intersect_portable<const FUSED: bool, const UNIT: u32, const BOXED: bool>(
         &self,
         ray: &Ray,
         stats: &mut impl TraversalStats,
@@ -173,7 +169,7 @@ impl Grid {
         // within the cell being visited, since every later cell lies beyond that cell.
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
-        let mut cells = self.occupied_cells::<true, FUSED, UNIT>(ray);
+        let mut cells = self.occupied_cells::<true, FUSED, UNIT, BOXED>(ray);
         while let Some((range, limit)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
@@ -195,42 +191,48 @@ impl Grid {
     /// cells given out. For the benchmark, to split a query's time between the walk and the
     /// triangles.
     pub fn walk(&self, ray: &Ray, t_stop: f32) -> usize {
-        match self.cells.unit_shift() {
-            0 => self.walk_at::<0>(ray, t_stop),
-            _ => self.walk_at::<1>(ray, t_stop),
+        match (self.cells.unit_shift(), self.cells.box_margin().is_some()) {
+            (0, false) => self.walk_at::<0, false>(ray, t_stop),
+            (0, true) => self.walk_at::<0, true>(ray, t_stop),
+            (_, false) => self.walk_at::<1, false>(ray, t_stop),
+            (_, true) => self.walk_at::<1, true>(ray, t_stop),
         }
     }
 
     /// [`Grid::walk`] for units of 2^`UNIT` cells, as [`Grid::intersect_at`].
     #[inline(always)]
-    fn walk_at<const UNIT: u32>(&self, ray: &Ray, t_stop: f32) -> usize {
+    fn walk_at<const UNIT: u32, const BOXED: bool>(&self, ray: &Ray, t_stop: f32) -> usize {
         // SAFETY (each arm): as in `intersect_counting`.
         #[cfg(target_arch = "x86_64")]
         match x86_level() {
-            X86Level::Avx512 => return unsafe { self.walk_avx512::<UNIT>(ray, t_stop) },
-            X86Level::Avx2 => return unsafe { self.walk_avx2::<UNIT>(ray, t_stop) },
+            X86Level::Avx512 => return unsafe { self.walk_avx512::<UNIT, BOXED>(ray, t_stop) },
+            X86Level::Avx2 => return unsafe { self.walk_avx2::<UNIT, BOXED>(ray, t_stop) },
             X86Level::Baseline => {}
         }
-        self.walk_portable::<false, UNIT>(ray, t_stop)
+        self.walk_portable::<false, UNIT, BOXED>(ray, t_stop)
     }
 
     /// [`Grid::walk_portable`] compiled for AVX2, like the queries.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
-    fn walk_avx2<const UNIT: u32>(&self, ray: &Ray, t_stop: f32) -> usize {
-        self.walk_portable::<true, UNIT>(ray, t_stop)
+    fn walk_avx2<const UNIT: u32, const BOXED: bool>(&self, ray: &Ray, t_stop: f32) -> usize {
+        self.walk_portable::<true, UNIT, BOXED>(ray, t_stop)
     }
 
     /// [`Grid::walk_portable`] compiled for AVX-512, like the queries.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
-    fn walk_avx512<const UNIT: u32>(&self, ray: &Ray, t_stop: f32) -> usize {
-        self.walk_portable::<true, UNIT>(ray, t_stop)
+    fn walk_avx512<const UNIT: u32, const BOXED: bool>(&self, ray: &Ray, t_stop: f32) -> usize {
+        self.walk_portable::<true, UNIT, BOXED>(ray, t_stop)
     }
 
     #[inline(always)]
-    fn walk_portable<const FUSED: bool, const UNIT: u32>(&self, ray: &Ray, t_stop: f32) -> usize {
-        let mut cells = self.occupied_cells::<false, FUSED, UNIT>(ray);
+    fn walk_portable<const FUSED: bool, const UNIT: u32, const BOXED: bool>(
+        &self,
+        ray: &Ray,
+        t_stop: f32,
+    ) -> usize {
+        let mut cells = self.occupied_cells::<false, FUSED, UNIT, BOXED>(ray);
         let mut visited = 0;
         while let Some((_, limit)) = cells.next(&mut ()) {
             visited += 1;
@@ -248,37 +250,51 @@ impl Grid {
 
     /// [`Grid::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        match self.cells.unit_shift() {
-            0 => self.occluded_at::<0>(ray, stats),
-            _ => self.occluded_at::<1>(ray, stats),
+        match (self.cells.unit_shift(), self.cells.box_margin().is_some()) {
+            (0, false) => self.occluded_at::<0, false>(ray, stats),
+            (0, true) => self.occluded_at::<0, true>(ray, stats),
+            (_, false) => self.occluded_at::<1, false>(ray, stats),
+            (_, true) => self.occluded_at::<1, true>(ray, stats),
         }
     }
 
     /// [`Grid::occluded_counting`] for units of 2^`UNIT` cells, as [`Grid::intersect_at`].
     #[inline(always)]
-    fn occluded_at<const UNIT: u32>(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+    fn occluded_at<const UNIT: u32, const BOXED: bool>(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> bool {
         // SAFETY (each arm): as in `intersect_counting`.
         #[cfg(target_arch = "x86_64")]
         match x86_level() {
-            X86Level::Avx512 => return unsafe { self.occluded_avx512::<UNIT>(ray, stats) },
-            X86Level::Avx2 => return unsafe { self.occluded_avx2::<UNIT>(ray, stats) },
+            X86Level::Avx512 => return unsafe { self.occluded_avx512::<UNIT, BOXED>(ray, stats) },
+            X86Level::Avx2 => return unsafe { self.occluded_avx2::<UNIT, BOXED>(ray, stats) },
             X86Level::Baseline => {}
         }
-        self.occluded_portable::<false, UNIT>(ray, stats)
+        self.occluded_portable::<false, UNIT, BOXED>(ray, stats)
     }
 
     /// [`Grid::occluded_portable`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
-    fn occluded_avx2<const UNIT: u32>(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.occluded_portable::<true, UNIT>(ray, stats)
+    fn occluded_avx2<const UNIT: u32, const BOXED: bool>(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> bool {
+        self.occluded_portable::<true, UNIT, BOXED>(ray, stats)
     }
 
     /// [`Grid::occluded_portable`] compiled for AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
-    fn occluded_avx512<const UNIT: u32>(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.occluded_portable::<true, UNIT>(ray, stats)
+    fn occluded_avx512<const UNIT: u32, const BOXED: bool>(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> bool {
+        self.occluded_portable::<true, UNIT, BOXED>(ray, stats)
     }
 
     /// The cells are walked from the segment's far end back to its origin (the answer does
@@ -292,7 +308,7 @@ impl Grid {
     /// random lengths 0.81, 0.88 and 1.01; light segments from a camera's hits, each traced
     /// after its camera ray (set `seen`), 0.94 on the full dragon and 1.00 on the 11k.
     #[inline(always)]
-    fn occluded_portable<const FUSED: bool, const UNIT: u32>(
+    fn occluded_portable<const FUSED: bool, const UNIT: u32, const BOXED: bool>(
         &self,
         ray: &Ray,
         stats: &mut impl TraversalStats,
@@ -301,7 +317,7 @@ impl Grid {
             UVec3::ONE => *ray,
             _ => self.frame.reversed(ray).unwrap_or(*ray),
         };
-        let mut cells = self.occupied_cells::<true, FUSED, UNIT>(&walked);
+        let mut cells = self.occupied_cells::<true, FUSED, UNIT, BOXED>(&walked);
         while let Some((range, _)) = cells.next(stats) {
             for block in &self.blocks[range] {
                 stats.test_triangles(block.len());
@@ -311,202 +327,6 @@ impl Grid {
             }
         }
         false
-    }
-
-    /// The occupied cells along `ray`, front to back.
-    #[inline(always)]
-    fn occupied_cells<'a, const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32>(
-        &'a self,
-        ray: &Ray,
-    ) -> OccupiedCells<'a, READ_BLOCKS, FUSED, UNIT> {
-        let single_cell = self.frame.resolution == UVec3::ONE;
-        let walk = if self.blocks.is_empty() || single_cell {
-            None
-        } else {
-            self.frame.start_walk::<FUSED>(ray)
-        };
-        OccupiedCells {
-            grid: self,
-            octant: walk.map_or(0, |w| reach::octant(w.step())),
-            walk,
-            single_cell: single_cell && !self.blocks.is_empty(),
-            ahead: None,
-            last_record: usize::MAX,
-            pause_ahead: walk.is_some_and(|w| w.from_outside),
-        }
-    }
-}
-
-/// The occupied cells along a ray, front to back (a cursor rather than an iterator, so the
-/// caller's statistics can ride along). Unless `READ_BLOCKS`, the cells' blocks are not
-/// asked for ahead of time ([`Grid::walk`]). `FUSED` as in [`CellWalk`]; `UNIT` the grid's
-/// [`super::cells::CellIndex::unit_shift`].
-struct OccupiedCells<'a, const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32> {
-    grid: &'a Grid,
-    /// `None` once the ray has left the grid.
-    walk: Option<CellWalk<FUSED>>,
-    /// The octant of the ray's direction ([`reach::octant`]).
-    octant: u32,
-    /// True until the one cell of a single-cell grid has been given out: such a grid is not
-    /// walked (a few triangles are tested faster all at once than found by a walk).
-    single_cell: bool,
-    /// The walk ahead of the cell given out last; `None` before the first is given out.
-    ahead: Option<Ahead>,
-    /// The record of the macrocell of the cell given out last.
-    last_record: usize,
-    /// True when the walk ahead of a cell stops at the next occupied macrocell: for a ray
-    /// that starts outside the grid's box ([`OccupiedCells::next`]).
-    pause_ahead: bool,
-}
-
-/// How far the walk ahead of the cell being tested went.
-enum Ahead {
-    /// To the next occupied cell (`None`: the ray leaves the grid without one).
-    Found(Option<Found>),
-    /// To an occupied macrocell other than the tested cell's, whose record it has asked
-    /// for; the walk goes on from there when the cell being tested holds no hit.
-    Paused,
-}
-
-impl Ahead {
-    /// The cell found, for a walk that may not pause (which finds one or leaves the grid).
-    fn into_found(self) -> Option<Found> {
-        match self {
-            Ahead::Found(found) => found,
-            Ahead::Paused => unreachable!("a walk that may not pause paused"),
-        }
-    }
-}
-
-/// An occupied cell: where its blocks lie in `blocks`, and the largest hit parameter that
-/// belongs to it (the last cell takes all up to the grid's end).
-type Found = (Range<usize>, f32);
-
-impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32>
-    OccupiedCells<'_, READ_BLOCKS, FUSED, UNIT>
-{
-    /// The next occupied cell along the ray.
-    ///
-    /// The walk runs one occupied cell ahead of the cell given out. Reading a cell's
-    /// blocks from memory (about 170 ns on a mesh the size of the full dragon) is the
-    /// largest single cost of a query, and the walk asks for all of a cell's blocks as soon
-    /// as it finds the cell ([`OccupiedCells::find_next`]), so those reads overlap the
-    /// tests of the cell before. Two cells ahead gained 1.00–1.03× on the full dragon's
-    /// bounce rays but lost 0.89× on its outside rays: cells found beyond the hit are
-    /// wasted work.
-    ///
-    /// For the same reason, a ray that starts outside the grid's box — which meets the
-    /// outside of the surface first, and most often hits it in the first occupied cells it
-    /// finds — stops its walk ahead at the next occupied macrocell other than the tested
-    /// cell's, having asked for that macrocell's record: the walk does not wait for a
-    /// record from memory that the tested cell's hit may make useless, and goes on from
-    /// there, the record on its way, if the cell holds none. A ray that starts inside
-    /// (bounce and shadow rays, leaving the surface they start on) walks on as before:
-    /// stopping cost its bounce rays 0.93× the speed.
-    #[inline(always)]
-    fn next(&mut self, stats: &mut impl TraversalStats) -> Option<Found> {
-        let grid = self.grid;
-        if self.single_cell {
-            self.single_cell = false;
-            stats.visit_occupied();
-            // Every hit belongs to the one cell.
-            return Some((0..grid.blocks.len(), f32::INFINITY));
-        }
-        let current = match self.ahead.take() {
-            Some(Ahead::Found(found)) => found,
-            // Before the first cell, or on from where the walk ahead stopped.
-            Some(Ahead::Paused) | None => self.find_next(stats, false).into_found(),
-        }?;
-        self.ahead = Some(self.find_next(stats, self.pause_ahead));
-        stats.visit_occupied();
-        Some(current)
-    }
-
-    /// The walk on to the next occupied cell: its blocks and hit limit; if `pause`, it stops
-    /// instead at an occupied macrocell other than that of the cell given out last.
-    #[inline(always)]
-    fn find_next(&mut self, stats: &mut impl TraversalStats, pause: bool) -> Ahead {
-        let grid = self.grid;
-        let Some(walk) = self.walk.as_mut() else {
-            return Ahead::Found(None);
-        };
-        loop {
-            let word = grid.cells.macrocell_of(walk.cell(), self.octant);
-            if let (true, Ok(record)) = (pause, word)
-                && record != self.last_record
-            {
-                grid.cells.prefetch_record::<UNIT>(record, self.octant);
-                stats.pause_ahead();
-                return Ahead::Paused;
-            }
-            stats.visit_cell();
-            let record = match word {
-                Ok(record) => {
-                    stats.enter_macrocell();
-                    grid.cells.prefetch_record::<UNIT>(record, self.octant);
-                    record
-                }
-                Err(sides) => {
-                    stats.leap_macrocells();
-                    // Past the empty box of cells ahead in this macrocell's corner
-                    // ([`reach`]).
-                    if !walk.leave_box(sides, MACRO_SHIFT as u32) {
-                        self.walk = None;
-                        return Ahead::Found(None);
-                    }
-                    continue;
-                }
-            };
-            // Within one occupied macrocell, its record serves every step until the walk
-            // leaves it: no macrocell lookup per cell.
-            let macrocell = walk.cell() >> MACRO_SHIFT;
-            loop {
-                match grid
-                    .cells
-                    .lookup_in::<UNIT>(record, walk.cell(), self.octant)
-                {
-                    // A cell whose reach is 1 is left by an ordinary step, cheaper than
-                    // leaving a cube of one cell; so is one whose 2³ unit has no empty
-                    // cube ahead (reach 0).
-                    Lookup::EmptyCell { reach } if reach >= 2 => {
-                        stats.leap_cells();
-                        // Past the empty cube of `reach` cells ahead
-                        // ([`super::cell_reach`]).
-                        if !walk.leave_cube(reach as f32, UNIT) {
-                            self.walk = None;
-                            return Ahead::Found(None);
-                        }
-                    }
-                    Lookup::Blocks(range) => {
-                        // All its blocks will be tested: ask for them now, while the walk
-                        // goes on to the next occupied cell.
-                        if READ_BLOCKS {
-                            for block in &grid.blocks[range.clone()] {
-                                prefetch(block);
-                            }
-                        }
-                        let (limit, more) = walk.advance();
-                        if !more {
-                            self.walk = None;
-                        }
-                        self.last_record = record;
-                        return Ahead::Found(Some((range, limit)));
-                    }
-                    // (`lookup_in` never answers `EmptyMacrocell`.)
-                    Lookup::EmptyCell { .. } | Lookup::EmptyMacrocell => {
-                        stats.step_cell();
-                        if !walk.advance().1 {
-                            self.walk = None;
-                            return Ahead::Found(None);
-                        }
-                    }
-                }
-                if walk.cell() >> MACRO_SHIFT != macrocell {
-                    break;
-                }
-                stats.visit_cell();
-            }
-        }
     }
 }
 
@@ -694,23 +514,23 @@ mod tests {
             let direction = Vec3::new(u(), u(), u()).normalize();
             let mut ray = Ray::new(origin, direction);
             let fast = grid.intersect(&ray);
-            let portable = grid.intersect_portable::<false, 0>(&ray, &mut ());
+            let portable = grid.intersect_portable::<false, 0, false>(&ray, &mut ());
             assert_eq!(fast, portable, "ray {k}: {ray:?}");
             // On a processor with AVX-512, the AVX2 version too.
             #[cfg(target_arch = "x86_64")]
             if x86_level() >= X86Level::Avx2 {
                 // SAFETY: the processor has AVX2 and the rest, as `x86_level` found.
-                let avx2 = unsafe { grid.intersect_avx2::<0>(&ray, &mut ()) };
+                let avx2 = unsafe { grid.intersect_avx2::<0, false>(&ray, &mut ()) };
                 assert_eq!(avx2, portable, "ray {k}: {ray:?}");
             }
             hits += usize::from(fast.is_some());
             ray.t_max = 1.5;
-            let blocked = grid.occluded_portable::<false, 0>(&ray, &mut ());
+            let blocked = grid.occluded_portable::<false, 0, false>(&ray, &mut ());
             assert_eq!(grid.occluded(&ray), blocked, "ray {k}: {ray:?}");
             #[cfg(target_arch = "x86_64")]
             if x86_level() >= X86Level::Avx2 {
                 // SAFETY: as above.
-                let avx2 = unsafe { grid.occluded_avx2::<0>(&ray, &mut ()) };
+                let avx2 = unsafe { grid.occluded_avx2::<0, false>(&ray, &mut ()) };
                 assert_eq!(avx2, blocked, "ray {k}: {ray:?}");
             }
         }
@@ -744,7 +564,7 @@ mod tests {
                 "ray {k}"
             );
             // The portable walk of units too (the query above ran the fast one).
-            let portable = per_unit.intersect_portable::<false, 1>(&ray, &mut ());
+            let portable = per_unit.intersect_portable::<false, 1, false>(&ray, &mut ());
             assert_eq!(portable, hit, "ray {k}");
             hits += usize::from(hit.is_some());
             for (leaps, counts) in leaps.iter_mut().zip(counts) {
@@ -753,12 +573,76 @@ mod tests {
             ray.t_max = 1.5;
             let blocked = per_cell.occluded(&ray);
             assert_eq!(per_unit.occluded(&ray), blocked, "ray {k}");
-            let portable = per_unit.occluded_portable::<false, 1>(&ray, &mut ());
+            let portable = per_unit.occluded_portable::<false, 1, false>(&ray, &mut ());
             assert_eq!(portable, blocked, "ray {k}");
         }
         assert!(hits > 5_000, "{hits} hits");
         // Both walks leave cubes of cells.
         assert!(leaps.iter().all(|&n| n > 1_000), "{leaps:?}");
+    }
+
+    /// A grid that keeps a box per occupied cell (as a grid whose blocks outgrow the caches
+    /// does, [`super::super::cell_box::boxed_for`]) is valid, passes cells by their boxes,
+    /// and finds exactly what the same grid without boxes finds, in both walks, with
+    /// reaches per cell and per 2³ unit, for rays from outside and from among the cells,
+    /// rays of huge and tiny direction vectors, and shadow segments; and a box that does
+    /// not hold its cell's triangles fails validation.
+    #[test]
+    fn cell_boxes_pass_cells_and_change_no_answer() {
+        use super::super::cell_box;
+        let plain = Grid::build(sphere(90));
+        assert!(plain.cells.box_margin().is_none());
+        let margin = cell_box::margin_for(&plain.frame).unwrap();
+        let mut rng = crate::render::sampling::Rng::new(43, 5);
+        for unit in [0, 1] {
+            let mut unboxed = plain.clone();
+            unboxed.cells.fill_reaches(unit);
+            let mut boxed = unboxed.clone();
+            boxed.cells.set_cell_boxes(boxed.cell_boxes(), margin);
+            boxed.validate().unwrap();
+            let (mut hits, mut tests) = (0, [0, 0]);
+            for k in 0..20_000 {
+                let mut u = || rng.uniform() * 2.0 - 1.0;
+                let origin = Vec3::new(u(), u(), u()) * if k % 2 == 0 { 3.0 } else { 0.9 };
+                let scale = [1.0, 1e-30, 1e12][k % 3];
+                let mut ray = Ray::new(origin, Vec3::new(u(), u(), u()).normalize() * scale);
+                let mut counts = [TraversalCounts::default(); 2];
+                let hit = unboxed.intersect_counting(&ray, &mut counts[0]);
+                assert_eq!(
+                    boxed.intersect_counting(&ray, &mut counts[1]),
+                    hit,
+                    "ray {k}"
+                );
+                let portable = match unit {
+                    0 => boxed.intersect_portable::<false, 0, true>(&ray, &mut ()),
+                    _ => boxed.intersect_portable::<false, 1, true>(&ray, &mut ()),
+                };
+                assert_eq!(portable, hit, "ray {k}");
+                hits += usize::from(hit.is_some());
+                for (tests, counts) in tests.iter_mut().zip(counts) {
+                    *tests += counts.tests;
+                }
+                ray.t_max = 1.5 / scale;
+                let blocked = unboxed.occluded(&ray);
+                assert_eq!(boxed.occluded(&ray), blocked, "ray {k}");
+                let portable = match unit {
+                    0 => boxed.occluded_portable::<false, 0, true>(&ray, &mut ()),
+                    _ => boxed.occluded_portable::<false, 1, true>(&ray, &mut ()),
+                };
+                assert_eq!(portable, blocked, "ray {k}");
+            }
+            assert!(hits > 5_000, "{hits} hits");
+            // The boxes spare a good share of the triangle tests.
+            assert!(tests[1] * 10 < tests[0] * 9, "tests {tests:?}");
+        }
+        // A box shrunk to a corner of its cell no longer holds its triangles.
+        let mut broken = plain.clone();
+        let mut boxes = broken.cell_boxes();
+        let middle = boxes.len() / 2;
+        boxes[middle] = cell_box::encode(Vec3::ZERO, Vec3::splat(0.01));
+        broken.cells.set_cell_boxes(boxes, margin);
+        let error = broken.validate().unwrap_err();
+        assert!(error.contains("box does not hold"), "{error}");
     }
 
     /// A ray whose direction is tiny (as a ray carried into the space of a hugely scaled
