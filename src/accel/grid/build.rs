@@ -1,14 +1,15 @@
 //! Grid construction: resolution, then count → prefix sums → fill into compact storage.
 
-use glam::{UVec3, Vec3};
+use glam::{IVec3, UVec3, Vec3};
 use rayon::prelude::*;
 
 use super::block::{Block, LANES};
+use super::cell_box::{self, CellBox};
 use super::cell_order::{Buckets, CellOrder, KeyParts};
 use super::cells::{CellIndex, MACRO_CELLS};
 use super::mesh_triangles::MeshTriangles;
 use super::overlap::{Polygon, TriangleBoxTest};
-use super::{Grid, cell_box, density};
+use super::{Grid, density};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::cpu::x86_fast_path;
 use crate::accel::frame::{GridFrame, padded, resolution};
@@ -151,64 +152,121 @@ impl Grid {
         // Each block's run of the sorted triangle numbers (start, length), in key order as
         // the index numbers them (empty macrocells, most of the grid, are passed over
         // whole).
-        let mut runs: Vec<(u32, u32)> = Vec::with_capacity(cells.block_count());
+        let mut runs: Vec<(u32, u32, IVec3)> = Vec::with_capacity(cells.block_count());
         let mut start = 0u32;
-        for macrocell in counts.chunks(MACRO_CELLS) {
+        for (mi, macrocell) in counts.chunks(MACRO_CELLS).enumerate() {
             if macrocell.iter().all(|&n| n == 0) {
                 continue;
             }
-            for &count in macrocell.iter().filter(|n| **n != 0) {
+            for (l, &count) in macrocell.iter().enumerate().filter(|(_, n)| **n != 0) {
+                let cell = CellIndex::cell_at(m, mi, l);
                 for first in (0..count).step_by(LANES) {
-                    runs.push((start + first, (count - first).min(LANES as u32)));
+                    runs.push((start + first, (count - first).min(LANES as u32), cell));
                 }
                 start += count;
             }
         }
         debug_assert_eq!(runs.len(), cells.block_count());
         drop(counts);
+        // Boxes per cell ([`cell_box`]) for a grid whose blocks outgrow the caches, each
+        // block's found as it is written, while its triangles are at hand.
+        let margin = cell_box::margin_for(&self.frame)
+            .filter(|_| cell_box::boxed_for(runs.len() * std::mem::size_of::<Block>()));
         let mut blocks: Vec<Block> = huge_pages::vec_with_capacity(runs.len());
-        runs.par_iter()
-            .map(|&(start, length)| {
-                let mut block = Block::EMPTY;
-                let run = &sorted[start as usize..(start + length) as usize];
-                for (lane, &t) in run.iter().enumerate() {
-                    block.set(lane, &triangles.get(t), t);
-                }
-                block
-            })
-            .collect_into_vec(&mut blocks);
+        let mut words: Vec<u32> = Vec::new();
+        let boxed = margin.is_some();
+        let block_of = |&run: &(u32, u32, IVec3)| self.block_of(run, &sorted, triangles, boxed);
+        if boxed {
+            runs.par_iter()
+                .map(block_of)
+                .unzip_into_vecs(&mut blocks, &mut words);
+        } else {
+            runs.par_iter()
+                .map(|run| block_of(run).0)
+                .collect_into_vec(&mut blocks);
+        }
         self.cells = cells;
         self.blocks = blocks;
         self.references = references;
-        self.fill_cell_boxes();
+        if let Some(margin) = margin {
+            let boxes = (0..self.cells.occupied())
+                .map(|k| cell_box::join_all(&words[self.cells.blocks_of(k)]))
+                .collect();
+            self.cells.set_cell_boxes(boxes, margin);
+        }
         true
     }
 
-    /// Per occupied cell, the box of its triangles within it ([`cell_box`]), if the grid
-    /// keeps boxes.
-    fn fill_cell_boxes(&mut self) {
-        let bytes = std::mem::size_of_val(self.blocks.as_slice());
-        if let Some(margin) =
-            cell_box::margin_for(&self.frame).filter(|_| cell_box::boxed_for(bytes))
-        {
-            let boxes = self.cell_boxes();
-            self.cells.set_cell_boxes(boxes, margin);
-        }
-    }
-
-    /// Every occupied cell's box word, in the order the cells are numbered.
+    /// Every occupied cell's box word, in the order the cells are numbered, found from the
+    /// written blocks (for tests: the build finds them as it writes the blocks).
+    #[cfg(test)]
     pub(super) fn cell_boxes(&self) -> Vec<u32> {
         let cells = self.cells.occupied_cells();
         cells
-            .par_iter()
+            .iter()
             .enumerate()
             .map(|(k, &c)| {
-                let stored = self.blocks[self.cells.blocks_of(k)]
-                    .iter()
-                    .flat_map(|block| (0..LANES).filter_map(|lane| block.get(lane)));
-                cell_box::of_cell(&self.frame, c, stored.map(|(triangle, _)| triangle))
+                let mut cell_box = CellBox::new(&self.frame, c);
+                for block in &self.blocks[self.cells.blocks_of(k)] {
+                    for (triangle, _) in (0..LANES).filter_map(|lane| block.get(lane)) {
+                        cell_box.add(&triangle);
+                    }
+                }
+                cell_box::join_all(&[cell_box.word()])
             })
             .collect()
+    }
+
+    /// The block of `run` (the start and length of its triangles in `sorted`, and its
+    /// cell), and if `boxed` the word of its triangles' box within the cell ([`cell_box`]).
+    fn block_of(
+        &self,
+        run: (u32, u32, IVec3),
+        sorted: &[u32],
+        triangles: MeshTriangles,
+        boxed: bool,
+    ) -> (Block, u32) {
+        #[cfg(target_arch = "x86_64")]
+        if x86_fast_path() {
+            // SAFETY: the processor has the features enabled there, checked just above.
+            return unsafe { self.block_of_avx2(run, sorted, triangles, boxed) };
+        }
+        self.block_of_portable(run, sorted, triangles, boxed)
+    }
+
+    /// [`Grid::block_of_portable`] compiled for AVX2, like the overlap tests (the
+    /// arithmetic, and so the grid, is the same).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
+    fn block_of_avx2(
+        &self,
+        run: (u32, u32, IVec3),
+        sorted: &[u32],
+        triangles: MeshTriangles,
+        boxed: bool,
+    ) -> (Block, u32) {
+        self.block_of_portable(run, sorted, triangles, boxed)
+    }
+
+    #[inline(always)]
+    fn block_of_portable(
+        &self,
+        (start, length, cell): (u32, u32, IVec3),
+        sorted: &[u32],
+        triangles: MeshTriangles,
+        boxed: bool,
+    ) -> (Block, u32) {
+        let mut block = Block::EMPTY;
+        let mut cell_box = boxed.then(|| CellBox::new(&self.frame, cell));
+        let run = &sorted[start as usize..(start + length) as usize];
+        for (lane, &t) in run.iter().enumerate() {
+            let triangle = triangles.get(t);
+            block.set(lane, &triangle, t);
+            if let Some(cell_box) = cell_box.as_mut() {
+                cell_box.add(&triangle);
+            }
+        }
+        (block, cell_box.map_or(0, |b| b.word()))
     }
 
     /// The (cell, triangle) pairs of the live triangles numbered in `chunk`, in triangle

@@ -336,7 +336,16 @@ impl CellIndex {
         Lookup::Blocks(self.offsets[k] as usize..self.offsets[k + 1] as usize, k)
     }
 
+    /// The cell `l` (x + 8y + 64z within its macrocell) of macrocell `mi` (x fastest) of a
+    /// grid of `macro_resolution` macrocells.
+    pub fn cell_at(macro_resolution: UVec3, mi: usize, l: usize) -> IVec3 {
+        let l = l as i32;
+        let local = IVec3::new(l & 7, l >> 3 & 7, l >> 6);
+        (dense_coordinates(macro_resolution, mi) << MACRO_SHIFT) + local
+    }
+
     /// The occupied cells' coordinates, in the order they are numbered.
+    #[cfg(test)]
     pub fn occupied_cells(&self) -> Vec<IVec3> {
         let mut cells = Vec::with_capacity(self.occupied());
         for (m, record, _) in self.macrocells() {
