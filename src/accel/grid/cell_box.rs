@@ -13,10 +13,10 @@
 //! cells' offsets ([`super::cells`]), whose first two lines a ray entering the macrocell
 //! asks for with the record. The build finds each block's box as it writes the block and
 //! joins a cell's; the full dragon's build takes 0.14–0.20 s, median 0.15 (0.10 s without
-//! boxes, Embree 0.16–0.17). Nothing is lost that the walk needs: a hit on one of the cell's triangles
-//! outside the cell lies in another cell along the ray, which holds the triangle too (the
-//! grid's exact hit-in-cell rule), so answers are bit for bit those of the grid without
-//! boxes.
+//! boxes, Embree 0.16–0.17). Nothing is lost that the walk needs: a hit on one of the
+//! cell's triangles outside the cell lies in another cell along the ray, which holds the
+//! triangle too (the grid's exact hit-in-cell rule), so answers are bit for bit those of
+//! the grid without boxes.
 //!
 //! On the full dragon, against the grid without boxes (`tools/grid-ab.sh a75f5a5
 //! dragon_vrip.ply.gz outside,camera,bounce,shadow,light 7`, identical answers), time of
