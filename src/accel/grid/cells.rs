@@ -339,9 +339,7 @@ impl CellIndex {
     /// The cell `l` (x + 8y + 64z within its macrocell) of macrocell `mi` (x fastest) of a
     /// grid of `macro_resolution` macrocells.
     pub fn cell_at(macro_resolution: UVec3, mi: usize, l: usize) -> IVec3 {
-        let l = l as i32;
-        let local = IVec3::new(l & 7, l >> 3 & 7, l >> 6);
-        (dense_coordinates(macro_resolution, mi) << MACRO_SHIFT) + local
+        (dense_coordinates(macro_resolution, mi) << MACRO_SHIFT) + local_coordinates(l)
     }
 
     /// The occupied cells' coordinates, in the order they are numbered.
@@ -353,9 +351,7 @@ impl CellIndex {
                 let bits = self.records[record].bits;
                 for l in 0..MACRO_CELLS {
                     if bits[l >> 6] >> (l & 63) & 1 != 0 {
-                        let l = l as i32;
-                        let local = IVec3::new(l & 7, l >> 3 & 7, l >> 6);
-                        cells.push((m << MACRO_SHIFT) + local);
+                        cells.push((m << MACRO_SHIFT) + local_coordinates(l));
                     }
                 }
             }
@@ -568,6 +564,12 @@ fn byte_lanes(v: u32) -> Vec3A {
 fn dense_coordinates(r: UVec3, mi: usize) -> IVec3 {
     let mi = mi as u32;
     UVec3::new(mi % r.x, mi / r.x % r.y, mi / (r.x * r.y)).as_ivec3()
+}
+
+/// A cell's coordinates within its macrocell, from its index there ([`local_index`]).
+fn local_coordinates(l: usize) -> IVec3 {
+    let l = l as i32;
+    IVec3::new(l & 7, l >> 3 & 7, l >> 6)
 }
 
 /// Index of a cell within its macrocell, from its coordinates there.

@@ -153,17 +153,8 @@ impl Polygon {
     /// The part of the polygon with `lo ≤ p[axis] ≤ hi` (Sutherland & Hodgman 1974, against
     /// the slab's two planes). Each plane adds at most one corner.
     pub fn clip(&self, axis: usize, lo: f32, hi: f32) -> Polygon {
-        self.clip_above(axis, lo).clip_below(axis, hi)
-    }
-
-    /// The part of the polygon with `lo ≤ p[axis]`.
-    pub fn clip_above(&self, axis: usize, lo: f32) -> Polygon {
         self.clip_plane(|p| p[axis] - lo, axis, lo)
-    }
-
-    /// The part of the polygon with `p[axis] ≤ hi`.
-    pub fn clip_below(&self, axis: usize, hi: f32) -> Polygon {
-        self.clip_plane(|p| hi - p[axis], axis, hi)
+            .clip_plane(|p| hi - p[axis], axis, hi)
     }
 
     /// Keeps the side where `inside(p) ≥ 0`; new corners lie on the plane `p[axis] = at`.
