@@ -85,6 +85,17 @@ impl Block {
         })
     }
 
+    /// The corners of the triangles ([`Triangle::vertices`]), corner by corner, axis by
+    /// axis, lane by lane, and which lanes are in use.
+    #[inline(always)]
+    pub fn corners(&self) -> ([[[f32; LANES]; 3]; 3], [bool; LANES]) {
+        let from_v0 = |e: &[[f32; LANES]; 3]| {
+            std::array::from_fn(|a| std::array::from_fn(|l| self.v0[a][l] + e[a][l]))
+        };
+        let corners = [self.v0, from_v0(&self.e1), from_v0(&self.e2)];
+        (corners, self.ids.map(|id| id != NO_TRIANGLE))
+    }
+
     /// Triangles in use.
     pub fn len(&self) -> usize {
         self.ids.iter().filter(|&&id| id != NO_TRIANGLE).count()

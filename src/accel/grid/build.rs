@@ -4,7 +4,7 @@ use glam::{IVec3, UVec3, Vec3};
 use rayon::prelude::*;
 
 use super::block::{Block, LANES};
-use super::cell_box::{self, CellBox};
+use super::cell_box;
 use super::cell_order::{Buckets, CellOrder, KeyParts};
 use super::cells::{CellIndex, MACRO_CELLS};
 use super::mesh_triangles::MeshTriangles;
@@ -206,13 +206,12 @@ impl Grid {
             .iter()
             .enumerate()
             .map(|(k, &c)| {
-                let mut cell_box = CellBox::new(&self.frame, c);
-                for block in &self.blocks[self.cells.blocks_of(k)] {
-                    for (triangle, _) in (0..LANES).filter_map(|lane| block.get(lane)) {
-                        cell_box.add(&triangle);
-                    }
-                }
-                cell_box::join_all(&[cell_box.word()])
+                let triangles = self.blocks[self.cells.blocks_of(k)]
+                    .iter()
+                    .flat_map(|block| {
+                        (0..LANES).filter_map(|lane| block.get(lane).map(|(triangle, _)| triangle))
+                    });
+                cell_box::join_all(&[cell_box::triangles_word(&self.frame, c, triangles)])
             })
             .collect()
     }
@@ -257,16 +256,16 @@ impl Grid {
         boxed: bool,
     ) -> (Block, u32) {
         let mut block = Block::EMPTY;
-        let mut cell_box = boxed.then(|| CellBox::new(&self.frame, cell));
         let run = &sorted[start as usize..(start + length) as usize];
         for (lane, &t) in run.iter().enumerate() {
-            let triangle = triangles.get(t);
-            block.set(lane, &triangle, t);
-            if let Some(cell_box) = cell_box.as_mut() {
-                cell_box.add(&triangle);
-            }
+            block.set(lane, &triangles.get(t), t);
         }
-        (block, cell_box.map_or(0, |b| b.word()))
+        let word = if boxed {
+            cell_box::block_word(&self.frame, cell, &block)
+        } else {
+            0
+        };
+        (block, word)
     }
 
     /// The (cell, triangle) pairs of the live triangles numbered in `chunk`, in triangle
@@ -530,6 +529,58 @@ mod tests {
             pairs += fast.iter().map(Vec::len).sum::<usize>();
         }
         assert!(pairs > 3 * triangles.len(), "{pairs} pairs");
+    }
+
+    /// The build's box words, found lane by lane for each block as it is written (compiled
+    /// for this processor and portably), are the words of the triangles' parts found
+    /// triangle by triangle, for triangles of every size, most of them crossing their
+    /// cells' faces.
+    #[test]
+    fn the_block_box_words_are_the_triangle_by_triangle_ones() {
+        let mut rng = crate::render::sampling::Rng::new(47, 3);
+        let triangles: Vec<Triangle> = (0..4_000)
+            .map(|k| {
+                let mut u = || rng.uniform() * 2.0 - 1.0;
+                let size = [0.01, 0.03, 0.1, 0.4][k % 4];
+                let a = Vec3::new(u(), u(), u());
+                Triangle::new(
+                    a,
+                    a + Vec3::new(u(), u(), u()) * size,
+                    a + Vec3::new(u(), u(), u()) * size,
+                )
+            })
+            .collect();
+        // Coarse cells, so that many hold several blocks.
+        let grid = Grid::build_with_density(triangles.clone(), 0.5);
+        let (vertices, indices) = soup(&triangles);
+        let mesh = MeshTriangles::new(&vertices, &indices);
+        let expected = grid.cell_boxes();
+        let cells = grid.cells.occupied_cells();
+        let (mut partial, mut blocks) = (0, 0);
+        for (k, &cell) in cells.iter().enumerate() {
+            let mut words = Vec::new();
+            for block in &grid.blocks[grid.cells.blocks_of(k)] {
+                let ids: Vec<u32> = (0..LANES)
+                    .filter_map(|l| block.get(l))
+                    .map(|(_, t)| t)
+                    .collect();
+                let run = (0, ids.len() as u32, cell);
+                let (fast, word) = grid.block_of(run, &ids, mesh, true);
+                assert_eq!(&fast, block);
+                assert_eq!(grid.block_of_portable(run, &ids, mesh, true), (fast, word));
+                words.push(word);
+                blocks += 1;
+            }
+            assert_eq!(cell_box::join_all(&words), expected[k], "cell {cell}");
+            partial += usize::from(expected[k] != cell_box::WHOLE);
+        }
+        // Most boxes are smaller than their cells, and many cells have several blocks.
+        assert!(
+            partial * 2 > cells.len(),
+            "{partial} of {} cells",
+            cells.len()
+        );
+        assert!(blocks > cells.len() + cells.len() / 10, "{blocks} blocks");
     }
 
     /// Small triangles keep the resolution asked for (the summed estimate fits at once);

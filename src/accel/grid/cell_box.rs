@@ -34,6 +34,7 @@
 
 use glam::{BVec3A, IVec3, Vec3, Vec3A};
 
+use super::block::{Block, LANES};
 use crate::accel::Triangle;
 use crate::accel::frame::{CellWalk, GridFrame};
 use crate::scene::Aabb;
@@ -72,53 +73,45 @@ pub(super) fn margin_for(frame: &GridFrame) -> Option<Vec3A> {
     (margin.max_element() < 0.25).then_some(margin.into())
 }
 
-/// The box of the parts of some triangles within one cell, gathered triangle by triangle.
-pub(super) struct CellBox {
-    cell: CellBounds,
-    inv_cell_size: Vec3,
-    lo: Vec3,
-    hi: Vec3,
+/// One value per lane of a block.
+type Lanes = [f32; LANES];
+
+/// A point per lane of a block, axis by axis.
+type LanePoints = [Lanes; 3];
+
+/// The word of the box of the parts within cell `c` of `block`'s triangles: bit for bit
+/// the word of [`CellBounds::part`] joined over them, found for the eight lanes at once
+/// and without a branch (a branch per triangle and crossed axis, whose outcome is as good
+/// as random, made the box pass 0.05 s of the full dragon's 0.15 s build).
+#[inline(always)]
+pub(super) fn block_word(frame: &GridFrame, c: IVec3, block: &Block) -> u32 {
+    let cell = CellBounds::new(frame, c);
+    let (corners, used) = block.corners();
+    word(frame, &cell, cell.lanes_part(&corners, used))
 }
 
-impl CellBox {
-    /// Nothing yet, in cell `c` of `frame`.
-    pub fn new(frame: &GridFrame, c: IVec3) -> CellBox {
-        CellBox {
-            cell: CellBounds::new(frame, c),
-            inv_cell_size: frame.inv_cell_size,
-            lo: Vec3::INFINITY,
-            hi: Vec3::NEG_INFINITY,
-        }
-    }
+/// The word of the box of the parts within cell `c` of `triangles`, found triangle by
+/// triangle: what [`block_word`] must find for a block of them.
+#[cfg(test)]
+pub(super) fn triangles_word(
+    frame: &GridFrame,
+    c: IVec3,
+    triangles: impl IntoIterator<Item = Triangle>,
+) -> u32 {
+    let cell = CellBounds::new(frame, c);
+    let parts = triangles.into_iter().filter_map(|t| cell.part(&t));
+    word(frame, &cell, parts.fold(Aabb::EMPTY, Aabb::union))
+}
 
-    /// Adds the part of `triangle` within the cell.
-    #[inline(always)]
-    pub fn add(&mut self, triangle: &Triangle) {
-        // A part lies within the triangle's bounds clamped to the cell: if the box already
-        // holds those, the part cannot grow it.
-        let bounds = triangle.bounds();
-        if bounds.min.max(self.cell.from).cmpge(self.lo).all()
-            && bounds.max.min(self.cell.to).cmple(self.hi).all()
-        {
-            return;
-        }
-        if let Some(bounds) = self.cell.part(triangle) {
-            self.lo = self.lo.min(bounds.min);
-            self.hi = self.hi.max(bounds.max);
-        }
+/// The word of `part`, a box within `cell` ([`NOTHING`] if it is empty).
+fn word(frame: &GridFrame, cell: &CellBounds, part: Aabb) -> u32 {
+    if part.min.cmpgt(part.max).any() {
+        return NOTHING;
     }
-
-    /// The word of the box ([`NOTHING`] if no part was left).
-    pub fn word(&self) -> u32 {
-        if self.lo.cmpgt(self.hi).any() {
-            return NOTHING;
-        }
-        let corner = self.cell.corner;
-        encode(
-            (self.lo - corner) * self.inv_cell_size,
-            (self.hi - corner) * self.inv_cell_size,
-        )
-    }
+    encode(
+        (part.min - cell.corner) * frame.inv_cell_size,
+        (part.max - cell.corner) * frame.inv_cell_size,
+    )
 }
 
 /// The box word that holds the boxes `words` hold (those of one cell's blocks); a whole
@@ -190,6 +183,92 @@ impl CellBounds {
             max: hi.into(),
         })
     }
+}
+
+impl CellBounds {
+    /// [`CellBounds::part`] of each lane's triangle, whose corners `corners` holds (corner
+    /// by corner), joined over the lanes `used`: the same box. Every lane is cut by its
+    /// part in all three slabs: for an axis whose faces a triangle does not cross, that
+    /// part holds all the triangle's corners, so the cut changes nothing.
+    #[inline(always)]
+    fn lanes_part(&self, corners: &[LanePoints; 3], used: [bool; LANES]) -> Aabb {
+        let (from, to) = (self.from, self.to);
+        let mut lanes_lo = [[0.0; LANES]; 3];
+        let mut lanes_hi = [[0.0; LANES]; 3];
+        for l in 0..LANES {
+            let corner = |k: usize| Vec3::new(corners[k][0][l], corners[k][1][l], corners[k][2][l]);
+            let c = [corner(0), corner(1), corner(2)];
+            let mut lo = greatest3(least3(least3(c[0], c[1]), c[2]), from);
+            let mut hi = least3(greatest3(greatest3(c[0], c[1]), c[2]), to);
+            let (x_lo, x_hi) = lane_slab_part::<0>(c, from.x, to.x);
+            let (y_lo, y_hi) = lane_slab_part::<1>(c, from.y, to.y);
+            let (z_lo, z_hi) = lane_slab_part::<2>(c, from.z, to.z);
+            lo = greatest3(greatest3(greatest3(lo, x_lo), y_lo), z_lo);
+            hi = least3(least3(least3(hi, x_hi), y_hi), z_hi);
+            let empty = !used[l] | (lo.x > hi.x) | (lo.y > hi.y) | (lo.z > hi.z);
+            let lo = if empty { Vec3::INFINITY } else { lo };
+            let hi = if empty { Vec3::NEG_INFINITY } else { hi };
+            (lanes_lo[0][l], lanes_lo[1][l], lanes_lo[2][l]) = (lo.x, lo.y, lo.z);
+            (lanes_hi[0][l], lanes_hi[1][l], lanes_hi[2][l]) = (hi.x, hi.y, hi.z);
+        }
+        let mut joined = Aabb::EMPTY;
+        for l in 0..LANES {
+            joined.min = least3(
+                joined.min,
+                Vec3::new(lanes_lo[0][l], lanes_lo[1][l], lanes_lo[2][l]),
+            );
+            joined.max = greatest3(
+                joined.max,
+                Vec3::new(lanes_hi[0][l], lanes_hi[1][l], lanes_hi[2][l]),
+            );
+        }
+        joined
+    }
+}
+
+/// [`slab_part`] for one lane's triangle, with corners `c`, in straight-line code on
+/// single numbers (so that the compiler runs the lanes side by side in vector lanes).
+#[inline(always)]
+fn lane_slab_part<const AXIS: usize>(c: [Vec3; 3], from: f32, to: f32) -> (Vec3, Vec3) {
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    let mut add = |p: Vec3, counts: bool| {
+        lo = least3(lo, if counts { p } else { Vec3::INFINITY });
+        hi = greatest3(hi, if counts { p } else { Vec3::NEG_INFINITY });
+    };
+    for (u, w) in [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])] {
+        let (x, y) = (u[AXIS], w[AXIS]);
+        add(u, (x >= from) & (x <= to));
+        for plane in [from, to] {
+            let (du, dw) = (x - plane, y - plane);
+            let crossing = ((du < 0.0) != (dw < 0.0)) & (du != dw);
+            add(u + (w - u) * (du / (du - dw)), crossing);
+        }
+    }
+    (lo, hi)
+}
+
+/// [`least`] axis by axis.
+#[inline(always)]
+fn least3(a: Vec3, b: Vec3) -> Vec3 {
+    Vec3::new(least(a.x, b.x), least(a.y, b.y), least(a.z, b.z))
+}
+
+/// [`greatest`] axis by axis.
+#[inline(always)]
+fn greatest3(a: Vec3, b: Vec3) -> Vec3 {
+    Vec3::new(greatest(a.x, b.x), greatest(a.y, b.y), greatest(a.z, b.z))
+}
+
+/// The lesser of `a` and `b`: for numbers, [`f32::min`], but one vector instruction.
+#[inline(always)]
+fn least(a: f32, b: f32) -> f32 {
+    if b < a { b } else { a }
+}
+
+/// The greater of `a` and `b`: for numbers, [`f32::max`], but one vector instruction.
+#[inline(always)]
+fn greatest(a: f32, b: f32) -> f32 {
+    if b > a { b } else { a }
 }
 
 /// The bounds of the part of the triangle with `corners` within the slab `from ≤ p[AXIS] ≤
