@@ -11,9 +11,10 @@
 //! triangle that crosses the faces of one axis). The bounds are kept in 31sts of the cell,
 //! rounded outwards, 5 bits a bound: a 32-bit word per occupied cell in an array beside the
 //! cells' offsets ([`super::cells`]), whose first two lines a ray entering the macrocell
-//! asks for with the record. The build finds each block's box as it writes the block and
-//! joins a cell's; the full dragon's build takes 0.14–0.20 s, median 0.15 (0.10 s without
-//! boxes, Embree 0.16–0.17). Nothing is lost that the walk needs: a hit on one of the
+//! asks for with the record. The build finds each block's box as it writes the block, for
+//! its eight triangles at once and without a branch ([`block_word`]), and joins a cell's;
+//! the full dragon's build takes 0.11–0.13 s (0.10 s without boxes, Embree 0.16–0.17).
+//! Nothing is lost that the walk needs: a hit on one of the
 //! cell's triangles outside the cell lies in another cell along the ray, which holds the
 //! triangle too (the grid's exact hit-in-cell rule), so answers are bit for bit those of
 //! the grid without boxes.
@@ -32,7 +33,7 @@
 //! there a block costs no more than the test, and the 11k dragon lost 1–12 % with boxes
 //! (docs/grid.md, twenty-sixth session).
 
-use glam::{BVec3A, IVec3, Vec3, Vec3A};
+use glam::{IVec3, Vec3, Vec3A};
 
 use super::block::{Block, LANES};
 use crate::accel::Triangle;
@@ -81,8 +82,9 @@ type LanePoints = [Lanes; 3];
 
 /// The word of the box of the parts within cell `c` of `block`'s triangles: bit for bit
 /// the word of [`CellBounds::part`] joined over them, found for the eight lanes at once
-/// and without a branch (a branch per triangle and crossed axis, whose outcome is as good
-/// as random, made the box pass 0.05 s of the full dragon's 0.15 s build).
+/// and without a branch. Found triangle by triangle, with a branch per crossed axis whose
+/// outcome is as good as random, the box pass took 0.05 s of the full dragon's 0.15 s
+/// build; this way it takes about 0.02 s.
 #[inline(always)]
 pub(super) fn block_word(frame: &GridFrame, c: IVec3, block: &Block) -> u32 {
     let cell = CellBounds::new(frame, c);
@@ -149,62 +151,21 @@ impl CellBounds {
     }
 
     /// Bounds that hold the part of `triangle` within the cell (`None` if nothing of it is
-    /// left): on each axis whose faces the triangle crosses, the bounds of its part within
-    /// that axis's slab (its corners inside the slab and its edges' crossings of the slab's
-    /// planes), all intersected with the cell. Exact for a triangle that crosses the faces
-    /// of one axis, as most do (and at least as tight as its bounds everywhere).
-    #[inline(always)]
+    /// left).
     fn part(&self, triangle: &Triangle) -> Option<Aabb> {
-        let bounds = triangle.bounds();
-        let crossed = bounds.min.cmplt(self.from) | bounds.max.cmpgt(self.to);
-        let (mut lo, mut hi) = (
-            Vec3A::from(bounds.min.max(self.from)),
-            Vec3A::from(bounds.max.min(self.to)),
-        );
-        if crossed.any() {
-            let corners = triangle.vertices().map(Vec3A::from);
-            let (from, to) = (Vec3A::from(self.from), Vec3A::from(self.to));
-            let mut within = |(slab_lo, slab_hi): (Vec3A, Vec3A)| {
-                lo = lo.max(slab_lo);
-                hi = hi.min(slab_hi);
-            };
-            if crossed.x {
-                within(slab_part::<0>(corners, from.x, to.x));
-            }
-            if crossed.y {
-                within(slab_part::<1>(corners, from.y, to.y));
-            }
-            if crossed.z {
-                within(slab_part::<2>(corners, from.z, to.z));
-            }
-        }
-        lo.cmple(hi).all().then(|| Aabb {
-            min: lo.into(),
-            max: hi.into(),
-        })
+        let (lo, hi) = self.part_bounds(triangle.vertices());
+        lo.cmple(hi).all().then_some(Aabb { min: lo, max: hi })
     }
-}
 
-impl CellBounds {
     /// [`CellBounds::part`] of each lane's triangle, whose corners `corners` holds (corner
-    /// by corner), joined over the lanes `used`: the same box. Every lane is cut by its
-    /// part in all three slabs: for an axis whose faces a triangle does not cross, that
-    /// part holds all the triangle's corners, so the cut changes nothing.
+    /// by corner), joined over the lanes `used`.
     #[inline(always)]
     fn lanes_part(&self, corners: &[LanePoints; 3], used: [bool; LANES]) -> Aabb {
-        let (from, to) = (self.from, self.to);
         let mut lanes_lo = [[0.0; LANES]; 3];
         let mut lanes_hi = [[0.0; LANES]; 3];
         for l in 0..LANES {
             let corner = |k: usize| Vec3::new(corners[k][0][l], corners[k][1][l], corners[k][2][l]);
-            let c = [corner(0), corner(1), corner(2)];
-            let mut lo = greatest3(least3(least3(c[0], c[1]), c[2]), from);
-            let mut hi = least3(greatest3(greatest3(c[0], c[1]), c[2]), to);
-            let (x_lo, x_hi) = lane_slab_part::<0>(c, from.x, to.x);
-            let (y_lo, y_hi) = lane_slab_part::<1>(c, from.y, to.y);
-            let (z_lo, z_hi) = lane_slab_part::<2>(c, from.z, to.z);
-            lo = greatest3(greatest3(greatest3(lo, x_lo), y_lo), z_lo);
-            hi = least3(least3(least3(hi, x_hi), y_hi), z_hi);
+            let (lo, hi) = self.part_bounds([corner(0), corner(1), corner(2)]);
             let empty = !used[l] | (lo.x > hi.x) | (lo.y > hi.y) | (lo.z > hi.z);
             let lo = if empty { Vec3::INFINITY } else { lo };
             let hi = if empty { Vec3::NEG_INFINITY } else { hi };
@@ -213,23 +174,41 @@ impl CellBounds {
         }
         let mut joined = Aabb::EMPTY;
         for l in 0..LANES {
-            joined.min = least3(
-                joined.min,
-                Vec3::new(lanes_lo[0][l], lanes_lo[1][l], lanes_lo[2][l]),
-            );
-            joined.max = greatest3(
-                joined.max,
-                Vec3::new(lanes_hi[0][l], lanes_hi[1][l], lanes_hi[2][l]),
-            );
+            let lane = |m: &LanePoints| Vec3::new(m[0][l], m[1][l], m[2][l]);
+            joined.min = least3(joined.min, lane(&lanes_lo));
+            joined.max = greatest3(joined.max, lane(&lanes_hi));
         }
         joined
     }
+
+    /// Bounds that hold the part within the cell of the triangle with corners `c` (lower
+    /// above upper on some axis if nothing of it is left): on each axis, the bounds of the
+    /// triangle's part within that axis's slab (its corners inside the slab and its edges'
+    /// crossings of the slab's planes), intersected with each other and with the cell.
+    /// Exact for a triangle that crosses the faces of one axis, as most do; for an axis
+    /// whose faces it does not cross, that part is the whole triangle. Straight-line code
+    /// on single numbers, with selections for branches (whose outcomes are as good as
+    /// random), so that [`CellBounds::lanes_part`] runs eight triangles side by side in
+    /// vector lanes.
+    #[inline(always)]
+    fn part_bounds(&self, c: [Vec3; 3]) -> (Vec3, Vec3) {
+        let (from, to) = (self.from, self.to);
+        let lo = greatest3(least3(least3(c[0], c[1]), c[2]), from);
+        let hi = least3(greatest3(greatest3(c[0], c[1]), c[2]), to);
+        let (x_lo, x_hi) = slab_part::<0>(c, from.x, to.x);
+        let (y_lo, y_hi) = slab_part::<1>(c, from.y, to.y);
+        let (z_lo, z_hi) = slab_part::<2>(c, from.z, to.z);
+        (
+            greatest3(greatest3(greatest3(lo, x_lo), y_lo), z_lo),
+            least3(least3(least3(hi, x_hi), y_hi), z_hi),
+        )
+    }
 }
 
-/// [`slab_part`] for one lane's triangle, with corners `c`, in straight-line code on
-/// single numbers (so that the compiler runs the lanes side by side in vector lanes).
+/// The bounds of the part of the triangle with corners `c` within the slab `from ≤ p[AXIS]
+/// ≤ to`: its corners inside the slab and its edges' crossings of the slab's planes.
 #[inline(always)]
-fn lane_slab_part<const AXIS: usize>(c: [Vec3; 3], from: f32, to: f32) -> (Vec3, Vec3) {
+fn slab_part<const AXIS: usize>(c: [Vec3; 3], from: f32, to: f32) -> (Vec3, Vec3) {
     let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     let mut add = |p: Vec3, counts: bool| {
         lo = least3(lo, if counts { p } else { Vec3::INFINITY });
@@ -269,30 +248,6 @@ fn least(a: f32, b: f32) -> f32 {
 #[inline(always)]
 fn greatest(a: f32, b: f32) -> f32 {
     if b > a { b } else { a }
-}
-
-/// The bounds of the part of the triangle with `corners` within the slab `from ≤ p[AXIS] ≤
-/// to`: its corners inside the slab and its edges' crossings of the slab's planes. Chosen
-/// by lane selections rather than branches, whose outcomes are as good as random (with
-/// branches, this took the full dragon's build from 0.10 s to 0.24 s).
-#[inline(always)]
-fn slab_part<const AXIS: usize>(corners: [Vec3A; 3], from: f32, to: f32) -> (Vec3A, Vec3A) {
-    let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-    for k in 0..3 {
-        let (u, w) = (corners[k], corners[(k + 1) % 3]);
-        let (x, y) = (u[AXIS], w[AXIS]);
-        let inside = BVec3A::splat((x >= from) & (x <= to));
-        lo = Vec3A::select(inside, lo.min(u), lo);
-        hi = Vec3A::select(inside, hi.max(u), hi);
-        for plane in [from, to] {
-            let (du, dw) = (x - plane, y - plane);
-            let crossing = BVec3A::splat(((du < 0.0) != (dw < 0.0)) & (du != dw));
-            let p = u + (w - u) * (du / (du - dw));
-            lo = Vec3A::select(crossing, lo.min(p), lo);
-            hi = Vec3A::select(crossing, hi.max(p), hi);
-        }
-    }
-    (lo, hi)
 }
 
 /// The word of the box from `lo` to `hi` (in cells from the cell's lower corner), each
@@ -370,7 +325,62 @@ pub(super) fn holds(
 
 #[cfg(test)]
 mod tests {
+    use glam::UVec3;
+
     use super::*;
+
+    /// A triangle's part within a cell holds every point of the triangle within the cell
+    /// (grown by the pad), and is often smaller than the triangle's bounds clamped to the
+    /// cell.
+    #[test]
+    fn a_part_holds_every_point_of_the_triangle_within_the_cell() {
+        let bounds = Aabb {
+            min: Vec3::splat(-1.0),
+            max: Vec3::splat(1.0),
+        };
+        let frame = GridFrame::new(bounds, UVec3::splat(4));
+        let mut rng = crate::render::sampling::Rng::new(53, 1);
+        let (mut met, mut tighter, mut points) = (0, 0, 0);
+        for k in 0..3_000 {
+            let mut u = || rng.uniform();
+            let size = [0.2, 0.6, 1.5][k % 3];
+            let a = Vec3::new(u(), u(), u()) * 2.0 - 1.0;
+            let mut corner = || a + (Vec3::new(u(), u(), u()) - 0.5) * size;
+            let triangle = Triangle::new(a, corner(), corner());
+            // The cell of the triangle's first corner.
+            let cell = CellBounds::new(&frame, frame.cell_of(a).as_ivec3());
+            let part = cell.part(&triangle);
+            for _ in 0..200 {
+                let (s, t) = (u(), u());
+                let (s, t) = if s + t > 1.0 {
+                    (1.0 - s, 1.0 - t)
+                } else {
+                    (s, t)
+                };
+                let p = triangle.v0 + triangle.e1 * s + triangle.e2 * t;
+                if p.cmpge(cell.from).all() && p.cmple(cell.to).all() {
+                    let part = part.expect("a part where the triangle meets the cell");
+                    let slack = Vec3::splat(1e-5);
+                    assert!(p.cmpge(part.min - slack).all() && p.cmple(part.max + slack).all());
+                    points += 1;
+                }
+            }
+            if let Some(part) = part {
+                let b = triangle.bounds();
+                let (lo, hi) = (b.min.max(cell.from), b.max.min(cell.to));
+                assert!(part.min.cmpge(lo).all() && part.max.cmple(hi).all());
+                met += 1;
+                tighter += usize::from(
+                    (part.max - part.min).element_product() < 0.9 * (hi - lo).element_product(),
+                );
+            }
+        }
+        assert!(points > 10_000, "{points} points");
+        assert!(
+            tighter * 4 > met,
+            "{tighter} of {met} parts tighter than the bounds"
+        );
+    }
 
     /// A box word holds bounds that contain the box encoded, clamped to the cell, and no
     /// more than a 31st wider on each side.
