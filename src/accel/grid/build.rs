@@ -498,24 +498,29 @@ mod tests {
         within_reference_budget(wanted, bounds, mesh, &live, &sizes_of(triangles))
     }
 
+    /// `count` triangles with a corner in the cube [−1, 1]³ and edges of up to the sizes
+    /// `sizes`, in turn.
+    fn random_triangles(seed: u64, count: usize, sizes: [f32; 4]) -> Vec<Triangle> {
+        let mut rng = crate::render::sampling::Rng::new(seed, 5);
+        (0..count)
+            .map(|k| {
+                let mut u = || rng.uniform() * 2.0 - 1.0;
+                let a = Vec3::new(u(), u(), u());
+                Triangle::new(
+                    a,
+                    a + Vec3::new(u(), u(), u()) * sizes[k % 4],
+                    a + Vec3::new(u(), u(), u()) * sizes[k % 4],
+                )
+            })
+            .collect()
+    }
+
     /// The overlap tests compiled for this processor pair each triangle with exactly the
     /// cells the portable ones give it: triangles of every size and slope, from slivers in
     /// one cell to ones across the grid (walked slab by slab).
     #[test]
     fn the_portable_overlap_tests_find_what_the_fast_ones_find() {
-        let mut rng = crate::render::sampling::Rng::new(41, 5);
-        let triangles: Vec<Triangle> = (0..6_000)
-            .map(|k| {
-                let mut u = || rng.uniform() * 2.0 - 1.0;
-                let size = [0.002, 0.02, 0.3, 1.5][k % 4];
-                let a = Vec3::new(u(), u(), u());
-                Triangle::new(
-                    a,
-                    a + Vec3::new(u(), u(), u()) * size,
-                    a + Vec3::new(u(), u(), u()) * size,
-                )
-            })
-            .collect();
+        let triangles = random_triangles(41, 6_000, [0.002, 0.02, 0.3, 1.5]);
         let grid = Grid::build(triangles.clone());
         let (vertices, indices) = soup(&triangles);
         let mesh = MeshTriangles::new(&vertices, &indices);
@@ -537,19 +542,7 @@ mod tests {
     /// cells' faces.
     #[test]
     fn the_block_box_words_are_the_triangle_by_triangle_ones() {
-        let mut rng = crate::render::sampling::Rng::new(47, 3);
-        let triangles: Vec<Triangle> = (0..4_000)
-            .map(|k| {
-                let mut u = || rng.uniform() * 2.0 - 1.0;
-                let size = [0.01, 0.03, 0.1, 0.4][k % 4];
-                let a = Vec3::new(u(), u(), u());
-                Triangle::new(
-                    a,
-                    a + Vec3::new(u(), u(), u()) * size,
-                    a + Vec3::new(u(), u(), u()) * size,
-                )
-            })
-            .collect();
+        let triangles = random_triangles(47, 4_000, [0.01, 0.03, 0.1, 0.4]);
         // Coarse cells, so that many hold several blocks.
         let grid = Grid::build_with_density(triangles.clone(), 0.5);
         let (vertices, indices) = soup(&triangles);
