@@ -14,10 +14,9 @@
 //! asks for with the record. The build finds each block's box as it writes the block, for
 //! its eight triangles at once and without a branch ([`block_word`]), and joins a cell's;
 //! the full dragon's build takes 0.11–0.13 s (0.10 s without boxes, Embree 0.16–0.17).
-//! Nothing is lost that the walk needs: a hit on one of the
-//! cell's triangles outside the cell lies in another cell along the ray, which holds the
-//! triangle too (the grid's exact hit-in-cell rule), so answers are bit for bit those of
-//! the grid without boxes.
+//! Nothing is lost that the walk needs: a hit on one of the cell's triangles outside the
+//! cell lies in another cell along the ray, which holds the triangle too (the grid's exact
+//! hit-in-cell rule), so answers are bit for bit those of the grid without boxes.
 //!
 //! On the full dragon, against the grid without boxes (`tools/grid-ab.sh a75f5a5
 //! dragon_vrip.ply.gz outside,camera,bounce,shadow,light 7`, identical answers), time of
