@@ -200,6 +200,11 @@ impl SceneAccel {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<SceneHit> {
+        if self.is_one_entry() {
+            stats.test_instance();
+            let hit = self.nearest_in(0, ray, ray.t_max, stats)?;
+            return Some(self.scene_hit(0, hit, ray));
+        }
         #[cfg(target_arch = "x86_64")]
         if x86_fast_path() {
             // SAFETY: the processor has the features enabled there, checked just above.
@@ -228,12 +233,6 @@ impl SceneAccel {
             }
         };
         match (&self.instance_grid, &self.list_bounds) {
-            // One entry (a model on its own): its grid clips the ray to its box, so the
-            // box lanes would only repeat that test.
-            (None, Some(_)) if self.entries.len() == 1 => {
-                stats.test_instance();
-                best = self.nearest_in(0, ray, t_max, stats).map(|hit| (0, hit));
-            }
             (None, Some(bounds)) => {
                 let slabs = bounds.slabs(ray, inv_direction);
                 for _ in &self.entries {
@@ -272,14 +271,28 @@ impl SceneAccel {
                 });
             }
         }
-        best.map(|(e, hit)| SceneHit {
+        best.map(|(e, hit)| self.scene_hit(e as usize, hit, ray))
+    }
+
+    /// `hit`, found in entry `e` by `ray`, as a hit in the scene.
+    #[inline(always)]
+    fn scene_hit(&self, e: usize, hit: GridHit, ray: &Ray) -> SceneHit {
+        SceneHit {
             t: hit.t,
-            instance: self.entries[e as usize].instance,
+            instance: self.entries[e].instance,
             triangle: hit.triangle,
             u: hit.u,
             v: hit.v,
             time: ray.time,
-        })
+        }
+    }
+
+    /// True for a scene of one entry (a model on its own) in a list: its grid clips each ray
+    /// to its box, so the box lanes would only repeat that test, and its queries go to the
+    /// grid at once.
+    #[inline(always)]
+    fn is_one_entry(&self) -> bool {
+        self.instance_grid.is_none() && self.entries.len() == 1
     }
 
     /// True when anything blocks `ray` within (`t_min`, `t_max`).
@@ -289,6 +302,10 @@ impl SceneAccel {
 
     /// [`SceneAccel::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        if self.is_one_entry() {
+            stats.test_instance();
+            return self.blocked_in(0, ray, stats);
+        }
         #[cfg(target_arch = "x86_64")]
         if x86_fast_path() {
             // SAFETY: the processor has the features enabled there, checked just above.
@@ -308,11 +325,6 @@ impl SceneAccel {
     fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         let inv_direction = ray.direction.recip();
         match (&self.instance_grid, &self.list_bounds) {
-            // One entry: as in the closest-hit query.
-            (None, Some(_)) if self.entries.len() == 1 => {
-                stats.test_instance();
-                self.blocked_in(0, ray, stats)
-            }
             (None, Some(bounds)) => {
                 let slabs = bounds.slabs(ray, inv_direction);
                 for _ in &self.entries {
@@ -606,12 +618,12 @@ mod tests {
         assert!((2_000..18_000).contains(&hits), "{hits} hits");
     }
 
-    /// A scene of one entry, whose queries go to its grid without the box lanes (and,
-    /// when the grid takes world rays as they are, with the caller's own ray), finds
-    /// exactly what the instance grid finds (the entry behind its bounds test, the ray
-    /// copied): for a mesh placed once, placed once and moving, and seen in one time slice
-    /// only; closest hits and shadow answers, at every shutter time, for rays from outside
-    /// and inside and segments of every length.
+    /// A scene of one entry, whose queries go to its grid at once (and, when the grid takes
+    /// world rays as they are, with the caller's own ray), finds exactly what the list's
+    /// box lanes (the portable query) and the instance grid find: for a mesh placed once,
+    /// placed once and moving, and seen in one time slice only; closest hits and shadow
+    /// answers, at every shutter time, for rays from outside and inside and segments of
+    /// every length.
     #[test]
     fn one_entry_finds_what_the_instance_grid_finds() {
         let mut rng = Rng::new(43, 2);
