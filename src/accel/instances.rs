@@ -211,7 +211,8 @@ impl SceneAccel {
     ) -> Option<SceneHit> {
         if self.is_one_entry() {
             stats.test_instance();
-            let hit = self.nearest_in_one_entry(ray, stats)?;
+            let hit =
+                self.ask_one_entry(ray, None, |grid, ray| grid.intersect_counting(ray, stats))?;
             return Some(self.scene_hit(0, hit, ray));
         }
         #[cfg(target_arch = "x86_64")]
@@ -316,7 +317,7 @@ impl SceneAccel {
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         if self.is_one_entry() {
             stats.test_instance();
-            return self.blocked_in_one_entry(ray, stats);
+            return self.ask_one_entry(ray, false, |grid, ray| grid.occluded_counting(ray, stats));
         }
         #[cfg(target_arch = "x86_64")]
         if x86_fast_path() {
@@ -388,36 +389,24 @@ impl SceneAccel {
         self.grids[entry.grid].intersect_counting(&local.with_t_max(t_max), stats)
     }
 
-    /// The nearest hit in the grid of a scene's one entry ([`SceneAccel::is_one_entry`]).
-    /// A grid that takes world rays as they are is given the caller's ray itself rather than
-    /// a copy: the grid then reads the ray the caller wrote, not one written just before
+    /// `query` asked of the grid of a scene's one entry ([`SceneAccel::is_one_entry`]) for
+    /// `ray` in its space; `missing` when the entry is not there at the ray's time. A grid
+    /// that takes world rays as they are is given the caller's ray itself rather than a
+    /// copy: the grid then reads the ray the caller wrote, not one written just before
     /// (docs/grid.md, thirtieth session). (Passing the ray on the same way to the entries of
     /// a list or an instance grid measured 0.93–0.95 the speed of the instances benchmark:
     /// not done.)
     #[inline(always)]
-    fn nearest_in_one_entry(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<GridHit> {
+    fn ask_one_entry<T>(&self, ray: &Ray, missing: T, query: impl FnOnce(&Grid, &Ray) -> T) -> T {
         let entry = &self.entries[0];
         let grid = &self.grids[entry.grid];
         if entry.takes_world_rays() {
-            return grid.intersect_counting(ray, stats);
+            return query(grid, ray);
         }
-        entry
-            .in_grid_space(ray)
-            .and_then(|local| grid.intersect_counting(&local, stats))
-    }
-
-    /// True when something in the grid of a scene's one entry blocks the ray; the ray passed
-    /// on as in [`SceneAccel::nearest_in_one_entry`].
-    #[inline(always)]
-    fn blocked_in_one_entry(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        let entry = &self.entries[0];
-        let grid = &self.grids[entry.grid];
-        if entry.takes_world_rays() {
-            return grid.occluded_counting(ray, stats);
+        match entry.in_grid_space(ray) {
+            Some(local) => query(grid, &local),
+            None => missing,
         }
-        entry
-            .in_grid_space(ray)
-            .is_some_and(|local| grid.occluded_counting(&local, stats))
     }
 
     /// True when entry `e` blocks the ray.
@@ -674,22 +663,17 @@ mod tests {
                 let origin = Vec3::new(u(), u(), u()) * if k % 2 == 0 { 3.0 } else { 0.8 };
                 let direction = Vec3::new(u(), u(), u()).normalize();
                 let ray = Ray::new(origin, direction).at_time(rng.uniform());
-                let found = one.intersect(&ray);
-                assert_eq!(found, grid.intersect(&ray), "{case}, ray {k}: {ray:?}");
-                assert_eq!(
-                    found,
-                    one.intersect_portable(&ray, &mut ()),
-                    "{case}, ray {k}"
-                );
-                hits += usize::from(found.is_some());
                 let segment = ray.with_t_max(3.0 * rng.uniform());
-                let answer = one.occluded(&segment);
-                assert_eq!(answer, grid.occluded(&segment), "{case}, ray {k}");
-                assert_eq!(
-                    answer,
+                let answers =
+                    |accel: &SceneAccel| (accel.intersect(&ray), accel.occluded(&segment));
+                let (found, answer) = answers(&one);
+                assert_eq!((found, answer), answers(&grid), "{case}, ray {k}: {ray:?}");
+                let portable = (
+                    one.intersect_portable(&ray, &mut ()),
                     one.occluded_portable(&segment, &mut ()),
-                    "{case}, ray {k}"
                 );
+                assert_eq!((found, answer), portable, "{case}, ray {k}: {ray:?}");
+                hits += usize::from(found.is_some());
                 blocked += usize::from(answer);
             }
             assert!(
