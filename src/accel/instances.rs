@@ -528,9 +528,6 @@ mod tests {
     use crate::render::sampling::Rng;
     use crate::scene::{Material, SceneBuilder};
 
-    /// The portable queries (compiled for baseline x86-64 here) find what the queries
-    /// compiled for this processor find, over a list of eleven entries (so both groups of
-    /// box lanes are used): the same nearest hit for every ray, the same shadow answers.
     /// An octahedron of radius 1 at the origin, added to `b`'s meshes.
     fn add_octahedron(b: &mut SceneBuilder) -> usize {
         let white = b.add_material(Material::diffuse("white", Vec3::splat(0.5)));
@@ -555,6 +552,9 @@ mod tests {
         b.add_mesh("octahedron", corners, faces, white)
     }
 
+    /// The portable queries (compiled for baseline x86-64 here) find what the queries
+    /// compiled for this processor find, over a list of eleven entries (so both groups of
+    /// box lanes are used): the same nearest hit for every ray, the same shadow answers.
     #[test]
     fn the_portable_top_level_finds_what_the_fast_one_finds() {
         let mut rng = Rng::new(41, 1);
