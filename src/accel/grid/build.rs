@@ -4,6 +4,7 @@ use glam::{IVec3, UVec3, Vec3};
 use rayon::prelude::*;
 
 use super::block::{Block, LANES};
+use super::block_order::{self, CellRun};
 use super::cell_box;
 use super::cell_order::{Buckets, CellOrder, KeyParts};
 use super::cells::{CellIndex, MACRO_CELLS};
@@ -16,6 +17,16 @@ use crate::accel::frame::{GridFrame, padded, resolution};
 use crate::accel::{Triangle, huge_pages};
 use crate::scene::Aabb;
 
+/// Which grids keep boxes per cell and per block ([`cell_box`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Boxes {
+    /// Those whose blocks outgrow the caches ([`cell_box::boxed_for`]).
+    BySize,
+    /// Every grid (for tests).
+    #[cfg_attr(not(test), allow(dead_code))]
+    Always,
+}
+
 /// Meshes of at most this many triangles (two blocks) get a single cell: a wall, a box.
 pub(super) const SINGLE_CELL_MAX: usize = 2 * LANES;
 
@@ -27,13 +38,13 @@ impl Grid {
     /// Builds a grid over a triangle soup, with the density chosen for it ([`density`]).
     pub fn build(triangles: Vec<Triangle>) -> Grid {
         let (vertices, indices) = soup(&triangles);
-        Grid::build_mesh(vertices, &indices, None)
+        Grid::build_mesh(vertices, &indices, None, Boxes::BySize)
     }
 
     /// Builds a grid over a triangle soup with about `density` cells per triangle.
     pub fn build_with_density(triangles: Vec<Triangle>, density: f32) -> Grid {
         let (vertices, indices) = soup(&triangles);
-        Grid::build_mesh(vertices, &indices, Some(density))
+        Grid::build_mesh(vertices, &indices, Some(density), Boxes::BySize)
     }
 
     /// Builds a grid over an indexed mesh, with the density chosen for it ([`density`]).
@@ -41,16 +52,29 @@ impl Grid {
     /// Degenerate triangles (no area, non-finite corners, or corners past the vertex array)
     /// go into no cell and so are never hit; hits report indices into `indices`.
     pub fn from_mesh(vertices: Vec<Vec3>, indices: &[[u32; 3]]) -> Grid {
-        Grid::build_mesh(vertices, indices, None)
+        Grid::build_mesh(vertices, indices, None, Boxes::BySize)
     }
 
     /// Builds a grid over an indexed mesh with about `density` cells per triangle.
     pub fn from_mesh_with_density(vertices: Vec<Vec3>, indices: &[[u32; 3]], density: f32) -> Grid {
-        Grid::build_mesh(vertices, indices, Some(density))
+        Grid::build_mesh(vertices, indices, Some(density), Boxes::BySize)
+    }
+
+    /// Builds a grid over a triangle soup with about `density` cells per triangle, keeping
+    /// boxes whatever its size (for tests: only large grids keep them otherwise).
+    #[cfg(test)]
+    pub(super) fn build_boxed(triangles: Vec<Triangle>, density: f32) -> Grid {
+        let (vertices, indices) = soup(&triangles);
+        Grid::build_mesh(vertices, &indices, Some(density), Boxes::Always)
     }
 
     /// [`Grid::from_mesh_with_density`], the density chosen for the mesh when `None`.
-    fn build_mesh(vertices: Vec<Vec3>, indices: &[[u32; 3]], density: Option<f32>) -> Grid {
+    fn build_mesh(
+        vertices: Vec<Vec3>,
+        indices: &[[u32; 3]],
+        density: Option<f32>,
+        boxes: Boxes,
+    ) -> Grid {
         let triangles = MeshTriangles::new(&vertices, indices);
         // The live triangles' numbers, bounds and summed sizes, chunk by chunk, joined in
         // order (so the sums are the same on any thread count; bounds are exact minima and
@@ -106,13 +130,14 @@ impl Grid {
             frame: GridFrame::new(bounds, resolution),
             cells: CellIndex::default(),
             blocks: Vec::new(),
+            block_boxes: Vec::new(),
             references: 0,
             triangle_count: indices.len(),
             inserted: live.len(),
         };
         // The estimate above keeps references far below 2^32; should it ever be wrong,
         // halve the resolution rather than overflow the 32-bit offsets.
-        while !grid.insert(triangles, &live) {
+        while !grid.insert(triangles, &live, boxes) {
             grid.frame = GridFrame::new(
                 grid.frame.bounds,
                 (grid.frame.resolution / 2).max(UVec3::ONE),
@@ -129,7 +154,7 @@ impl Grid {
     /// Within a cell, triangles keep mesh order whatever the thread count, so ties between
     /// equal hits resolve the same way. False, with nothing changed, if there are more
     /// references than 32-bit offsets hold.
-    fn insert(&mut self, triangles: MeshTriangles, live: &[u32]) -> bool {
+    fn insert(&mut self, triangles: MeshTriangles, live: &[u32], boxes: Boxes) -> bool {
         let m = CellIndex::macro_resolution_for(self.frame.resolution);
         let keys = (m.x * m.y * m.z) as usize * MACRO_CELLS;
         let parts = KeyParts::new(keys);
@@ -141,7 +166,7 @@ impl Grid {
         if references >= u32::MAX as usize && self.frame.resolution != UVec3::ONE {
             return false;
         }
-        let CellOrder { counts, sorted } = parts.sort(&chunks, keys);
+        let CellOrder { counts, mut sorted } = parts.sort(&chunks, keys);
         drop(chunks);
         let cells = CellIndex::build(
             self.frame.resolution,
@@ -153,6 +178,13 @@ impl Grid {
         // the index numbers them (empty macrocells, most of the grid, are passed over
         // whole).
         let mut runs: Vec<(u32, u32, IVec3)> = Vec::with_capacity(cells.block_count());
+        // Boxes per cell and per block ([`cell_box`]) for a grid whose blocks outgrow the
+        // caches, each block's found as it is written, while its triangles are at hand; the
+        // triangles of its cells of more than one block in Morton order ([`block_order`]).
+        let block_bytes = cells.block_count() * std::mem::size_of::<Block>();
+        let margin = cell_box::margin_for(&self.frame)
+            .filter(|_| boxes == Boxes::Always || cell_box::boxed_for(block_bytes));
+        let mut crowded: Vec<CellRun> = Vec::new();
         let mut start = 0u32;
         for (mi, macrocell) in counts.chunks(MACRO_CELLS).enumerate() {
             if macrocell.iter().all(|&n| n == 0) {
@@ -163,15 +195,16 @@ impl Grid {
                 for first in (0..count).step_by(LANES) {
                     runs.push((start + first, (count - first).min(LANES as u32), cell));
                 }
+                if margin.is_some() && count > LANES as u32 {
+                    crowded.push((start, count, cell));
+                }
                 start += count;
             }
         }
         debug_assert_eq!(runs.len(), cells.block_count());
         drop(counts);
-        // Boxes per cell ([`cell_box`]) for a grid whose blocks outgrow the caches, each
-        // block's found as it is written, while its triangles are at hand.
-        let margin = cell_box::margin_for(&self.frame)
-            .filter(|_| cell_box::boxed_for(runs.len() * std::mem::size_of::<Block>()));
+        block_order::order_cells(&self.frame, &mut sorted, &crowded, triangles);
+        drop(crowded);
         let mut blocks: Vec<Block> = huge_pages::vec_with_capacity(runs.len());
         let mut words: Vec<u32> = Vec::new();
         let boxed = margin.is_some();
@@ -194,7 +227,24 @@ impl Grid {
                 .collect();
             self.cells.set_cell_boxes(boxes, margin);
         }
+        if boxed {
+            self.block_boxes = words;
+        }
         true
+    }
+
+    /// Every block's box word within its cell, found from the written blocks (for tests: the
+    /// build finds them as it writes the blocks).
+    #[cfg(test)]
+    pub(super) fn block_box_words(&self) -> Vec<u32> {
+        let cells = self.cells.occupied_cells();
+        let mut words = vec![0; self.blocks.len()];
+        for (k, &c) in cells.iter().enumerate() {
+            for b in self.cells.blocks_of(k) {
+                words[b] = cell_box::block_word(&self.frame, c, &self.blocks[b]);
+            }
+        }
+        words
     }
 
     /// Every occupied cell's box word, in the order the cells are numbered, found from the
@@ -574,6 +624,67 @@ mod tests {
             cells.len()
         );
         assert!(blocks > cells.len() + cells.len() / 10, "{blocks} blocks");
+    }
+
+    /// A grid that keeps boxes has each block's box word, and the triangles of each of its
+    /// cells of several blocks in Morton order: the cell's triangles as in mesh order, each
+    /// cell's keys ascending (ties by triangle number), and the blocks' boxes smaller than
+    /// in mesh order.
+    #[test]
+    fn a_boxed_grid_orders_its_crowded_cells_and_keeps_each_blocks_box() {
+        // Triangles smaller than the cells, in cells of several blocks each, as on a large
+        // scanned mesh.
+        let triangles = random_triangles(53, 4_000, [0.01, 0.02, 0.03, 0.05]);
+        let boxed = Grid::build_boxed(triangles.clone(), 0.05);
+        let plain = Grid::build_with_density(triangles.clone(), 0.05);
+        boxed.validate().unwrap();
+        assert!(boxed.cells.box_margin().is_some() && plain.cells.box_margin().is_none());
+        assert_eq!(boxed.block_boxes, boxed.block_box_words());
+        assert_eq!(boxed.cells.occupied_cells(), plain.cells.occupied_cells());
+        let ids = |grid: &Grid, k: usize| -> Vec<u32> {
+            grid.blocks[grid.cells.blocks_of(k)]
+                .iter()
+                .flat_map(|block| (0..LANES).filter_map(|l| block.get(l).map(|(_, t)| t)))
+                .collect()
+        };
+        let volume = |words: &[u32]| -> f64 {
+            let sides = words.iter().map(|&w| {
+                let (lo, hi) = cell_box::decode::<false>(w);
+                (hi - lo).max(glam::Vec3A::ZERO)
+            });
+            sides.map(|s| f64::from(s.x * s.y * s.z)).sum()
+        };
+        let plain_words = plain.block_box_words();
+        let (mut crowded, mut boxed_volume, mut plain_volume) = (0, 0.0, 0.0);
+        for (k, &cell) in boxed.cells.occupied_cells().iter().enumerate() {
+            let (ordered, mesh_order) = (ids(&boxed, k), ids(&plain, k));
+            if mesh_order.len() <= LANES {
+                assert_eq!(ordered, mesh_order, "cell {cell}");
+                continue;
+            }
+            crowded += 1;
+            let mut sorted = ordered.clone();
+            sorted.sort_unstable();
+            assert_eq!(sorted, mesh_order, "cell {cell}");
+            let keys: Vec<(u32, u32)> = ordered
+                .iter()
+                .map(|&t| {
+                    (
+                        block_order::key(&boxed.frame, cell, triangles[t as usize].bounds()),
+                        t,
+                    )
+                })
+                .collect();
+            assert!(keys.is_sorted(), "cell {cell}: {keys:?}");
+            let blocks = boxed.cells.blocks_of(k);
+            boxed_volume += volume(&boxed.block_boxes[blocks.clone()]);
+            plain_volume += volume(&plain_words[blocks]);
+        }
+        assert!(crowded > 100, "{crowded} crowded cells");
+        assert!(
+            boxed_volume < 0.8 * plain_volume,
+            "{boxed_volume} against {plain_volume}"
+        );
     }
 
     /// Small triangles keep the resolution asked for (the summed estimate fits at once);

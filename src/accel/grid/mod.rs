@@ -13,6 +13,7 @@
 //! cell.
 
 mod block;
+mod block_order;
 mod box_counts;
 mod build;
 mod cell_box;
@@ -45,6 +46,9 @@ pub struct Grid {
     cells: CellIndex,
     /// The triangles of every occupied cell, eight to a block, cell after cell.
     blocks: Vec<Block>,
+    /// For a grid that keeps boxes ([`cell_box`]), each block's box word within its cell, so
+    /// the walk tests only the blocks of a cell whose boxes the ray meets; empty otherwise.
+    block_boxes: Vec<u32>,
     /// Triangle references in `blocks` (lanes in use).
     references: usize,
     /// Triangles given to the build, degenerate ones included.
@@ -116,7 +120,8 @@ impl Grid {
             empty_fraction: 1.0 - occupied as f64 / cells as f64,
             bytes: std::mem::size_of::<Grid>()
                 + self.cells.bytes()
-                + std::mem::size_of_val(self.blocks.as_slice()),
+                + std::mem::size_of_val(self.blocks.as_slice())
+                + std::mem::size_of_val(self.block_boxes.as_slice()),
         }
     }
 
@@ -131,6 +136,16 @@ impl Grid {
         self.cells.validate(self.frame.resolution)?;
         if self.cells.block_count() != self.blocks.len() {
             return Err("offsets and blocks disagree in length".into());
+        }
+        let block_boxes = match self.cells.box_margin() {
+            Some(_) => self.blocks.len(),
+            None => 0,
+        };
+        if self.block_boxes.len() != block_boxes {
+            return Err(format!(
+                "{} block boxes for {block_boxes}",
+                self.block_boxes.len()
+            ));
         }
         if self.blocks.iter().any(|b| b.len() == 0)
             || self.blocks.iter().map(Block::len).sum::<usize>() != self.references
@@ -151,9 +166,10 @@ impl Grid {
                         min: lo - self.frame.cell_size * 1e-3,
                         max: lo + self.frame.cell_size * 1.001,
                     };
-                    let stored = range
-                        .flat_map(|k| (0..block::LANES).filter_map(move |l| self.blocks[k].get(l)));
-                    for (triangle, id) in stored {
+                    let stored = range.flat_map(|k| {
+                        (0..block::LANES).filter_map(move |l| self.blocks[k].get(l).map(|s| (k, s)))
+                    });
+                    for (in_block, (triangle, id)) in stored {
                         let id = id as usize;
                         let b = triangle.bounds();
                         if id >= self.triangle_count {
@@ -171,6 +187,19 @@ impl Grid {
                             && !cell_box::holds(&self.frame, c.as_ivec3(), word, margin, &triangle)
                         {
                             return Err(format!("cell {c}'s box does not hold triangle {id}"));
+                        }
+                        if let Some((_, margin)) = boxed
+                            && !cell_box::holds(
+                                &self.frame,
+                                c.as_ivec3(),
+                                self.block_boxes[in_block],
+                                margin,
+                                &triangle,
+                            )
+                        {
+                            return Err(format!(
+                                "block {in_block}'s box does not hold triangle {id}"
+                            ));
                         }
                         seen[id] = true;
                     }

@@ -7,7 +7,8 @@ use std::ops::Range;
 use glam::{UVec3, Vec3A};
 
 use super::Grid;
-use super::cell_box;
+use super::block::Block;
+use super::cell_box::{self, MASKED_BLOCKS};
 use super::cells::{Lookup, MACRO_SHIFT};
 use super::reach;
 use super::traverse::TraversalStats;
@@ -44,6 +45,53 @@ impl Grid {
             pause_ahead: walk.is_some_and(|w| w.from_outside),
             box_margin: self.cells.box_margin().unwrap_or(Vec3A::ZERO),
         }
+    }
+}
+
+impl Grid {
+    /// The blocks of an occupied cell that its walk gives out ([`Found`]): for a grid that
+    /// keeps boxes, those of `range` that `mask` holds, then any after the first 64.
+    #[inline(always)]
+    pub(super) fn cell_blocks<const BOXED: bool>(
+        &self,
+        range: &Range<usize>,
+        mask: u64,
+    ) -> CellBlocks<'_, BOXED> {
+        CellBlocks {
+            blocks: &self.blocks[range.clone()],
+            mask,
+            next: MASKED_BLOCKS,
+        }
+    }
+}
+
+/// The blocks of a cell to test ([`Grid::cell_blocks`]).
+pub(super) struct CellBlocks<'a, const BOXED: bool> {
+    blocks: &'a [Block],
+    /// The blocks among the first 64 not yet given out.
+    mask: u64,
+    /// The next block after the first 64.
+    next: usize,
+}
+
+impl<'a, const BOXED: bool> Iterator for CellBlocks<'a, BOXED> {
+    type Item = &'a Block;
+
+    #[inline(always)]
+    fn next(&mut self) -> Option<&'a Block> {
+        if !BOXED {
+            let (first, rest) = self.blocks.split_first()?;
+            self.blocks = rest;
+            return Some(first);
+        }
+        if self.mask != 0 {
+            let i = self.mask.trailing_zeros() as usize;
+            self.mask &= self.mask - 1;
+            return self.blocks.get(i);
+        }
+        let block = self.blocks.get(self.next)?;
+        self.next += 1;
+        Some(block)
     }
 }
 
@@ -97,9 +145,11 @@ impl Ahead {
     }
 }
 
-/// An occupied cell: where its blocks lie in `blocks`, and the largest hit parameter that
-/// belongs to it (the last cell takes all up to the grid's end).
-pub(super) type Found = (Range<usize>, f32);
+/// An occupied cell: where its blocks lie in `blocks`, which of them the ray may meet (for
+/// a grid that keeps boxes, [`cell_box::block_mask`]; bit `i` for the `i`-th block of the
+/// first 64, every block after them), and the largest hit parameter that belongs to it (the
+/// last cell takes all up to the grid's end).
+pub(super) type Found = (Range<usize>, u64, f32);
 
 impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32, const BOXED: bool>
     OccupiedCells<'_, READ_BLOCKS, FUSED, UNIT, BOXED>
@@ -129,7 +179,9 @@ impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32, const BOXED: b
             self.single_cell = false;
             stats.visit_occupied();
             // Every hit belongs to the one cell.
-            return Some((0..grid.blocks.len(), f32::INFINITY));
+            let all = grid.blocks.len();
+            let mask = u64::MAX >> (MASKED_BLOCKS - all.clamp(1, MASKED_BLOCKS));
+            return Some((0..all, mask, f32::INFINITY));
         }
         let current = match self.ahead.take() {
             Some(Ahead::Found(found)) => found,
@@ -201,19 +253,27 @@ impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32, const BOXED: b
                     Lookup::Blocks(range, k) => {
                         // A cell whose triangles' box the ray passes is given out with no
                         // blocks ([`cell_box`]; without a branch on it, whose outcome is
-                        // as good as random).
-                        let range = if BOXED {
+                        // as good as random); of a cell of several blocks, only those
+                        // whose boxes the ray meets.
+                        let (range, mask) = if BOXED {
                             let word = grid.cells.cell_box(k);
                             let meets = cell_box::meets(walk, word, self.box_margin);
                             let keep = usize::from(meets).wrapping_neg();
-                            range.start..range.start + (range.len() & keep)
+                            let range = range.start..range.start + (range.len() & keep);
+                            let mask = if range.len() > 1 {
+                                let words = &grid.block_boxes;
+                                cell_box::block_mask(walk, words, range.clone(), self.box_margin)
+                            } else {
+                                range.len() as u64
+                            };
+                            (range, mask)
                         } else {
-                            range
+                            (range, u64::MAX)
                         };
-                        // All its blocks will be tested: ask for them now, while the walk
+                        // All its blocks to be tested: ask for them now, while the walk
                         // goes on to the next occupied cell.
                         if READ_BLOCKS {
-                            for block in &grid.blocks[range.clone()] {
+                            for block in grid.cell_blocks::<BOXED>(&range, mask) {
                                 prefetch(block);
                             }
                         }
@@ -222,7 +282,7 @@ impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32, const BOXED: b
                             self.walk = None;
                         }
                         self.last_record = record;
-                        return Ahead::Found(Some((range, limit)));
+                        return Ahead::Found(Some((range, mask, limit)));
                     }
                     // (`lookup_in` never answers `EmptyMacrocell`.)
                     Lookup::EmptyCell { .. } | Lookup::EmptyMacrocell => {

@@ -170,8 +170,8 @@ impl Grid {
         let mut nearest: Option<GridHit> = None;
         let mut t_nearest = ray.t_max;
         let mut cells = self.occupied_cells::<true, FUSED, UNIT, BOXED>(ray);
-        while let Some((range, limit)) = cells.next(stats) {
-            for block in &self.blocks[range] {
+        while let Some((range, mask, limit)) = cells.next(stats) {
+            for block in self.cell_blocks::<BOXED>(&range, mask) {
                 stats.test_triangles(block.len());
                 if let Some(hit) = block.nearest(ray, t_nearest) {
                     t_nearest = hit.t;
@@ -234,7 +234,7 @@ impl Grid {
     ) -> usize {
         let mut cells = self.occupied_cells::<false, FUSED, UNIT, BOXED>(ray);
         let mut visited = 0;
-        while let Some((_, limit)) = cells.next(&mut ()) {
+        while let Some((.., limit)) = cells.next(&mut ()) {
             visited += 1;
             if t_stop <= limit {
                 break;
@@ -318,8 +318,8 @@ impl Grid {
             _ => self.frame.reversed(ray).unwrap_or(*ray),
         };
         let mut cells = self.occupied_cells::<true, FUSED, UNIT, BOXED>(&walked);
-        while let Some((range, _)) = cells.next(stats) {
-            for block in &self.blocks[range] {
+        while let Some((range, mask, _)) = cells.next(stats) {
+            for block in self.cell_blocks::<BOXED>(&range, mask) {
                 stats.test_triangles(block.len());
                 if block.any(ray, ray.t_max) {
                     return true;
@@ -334,6 +334,7 @@ impl Grid {
 mod tests {
     use glam::Vec3;
 
+    use super::super::cell_box::{self, MASKED_BLOCKS};
     use super::*;
     use crate::accel::Triangle;
 
@@ -589,7 +590,6 @@ mod tests {
     /// not hold its cell's triangles fails validation.
     #[test]
     fn cell_boxes_pass_cells_and_change_no_answer() {
-        use super::super::cell_box;
         let plain = Grid::build(sphere(90));
         assert!(plain.cells.box_margin().is_none());
         let margin = cell_box::margin_for(&plain.frame).unwrap();
@@ -599,6 +599,7 @@ mod tests {
             unboxed.cells.fill_reaches(unit);
             let mut boxed = unboxed.clone();
             boxed.cells.set_cell_boxes(boxed.cell_boxes(), margin);
+            boxed.block_boxes = boxed.block_box_words();
             boxed.validate().unwrap();
             let (mut hits, mut tests) = (0, [0, 0]);
             for k in 0..20_000 {
@@ -641,8 +642,69 @@ mod tests {
         let middle = boxes.len() / 2;
         boxes[middle] = cell_box::encode(Vec3::ZERO, Vec3::splat(0.01));
         broken.cells.set_cell_boxes(boxes, margin);
+        broken.block_boxes = broken.block_box_words();
         let error = broken.validate().unwrap_err();
         assert!(error.contains("box does not hold"), "{error}");
+    }
+
+    /// A grid that keeps boxes per block tests only the blocks of a cell whose boxes the ray
+    /// meets, and finds what the same grid without boxes finds (the same hit parameter, and
+    /// the same triangle but where two are hit at the same distance, which the order of a
+    /// cell's triangles decides), fewer triangles tested than with boxes per cell alone.
+    #[test]
+    fn block_boxes_pass_blocks_and_change_no_answer() {
+        let triangles = sphere(90);
+        // Coarse cells, so that many hold several blocks; and cells of more than 64 blocks,
+        // whose blocks after the 64th no mask bit stands for.
+        for density in [0.3, 0.002] {
+            let plain = Grid::build_with_density(triangles.clone(), density);
+            let boxed = Grid::build_boxed(triangles.clone(), density);
+            assert_eq!(boxed.cells.unit_shift(), 0);
+            let most = (0..boxed.cells.occupied())
+                .map(|k| boxed.cells.blocks_of(k).len())
+                .max();
+            assert!(
+                density > 0.01 || most > Some(MASKED_BLOCKS),
+                "{most:?} blocks"
+            );
+            let mut cell_boxes_only = boxed.clone();
+            cell_boxes_only.block_boxes.fill(cell_box::WHOLE);
+            let mut rng = crate::render::sampling::Rng::new(59, 2);
+            let (mut hits, mut tests) = (0, [0; 2]);
+            for k in 0..20_000 {
+                let mut u = || rng.uniform() * 2.0 - 1.0;
+                let origin = Vec3::new(u(), u(), u()) * if k % 2 == 0 { 3.0 } else { 0.9 };
+                let mut ray = Ray::new(origin, Vec3::new(u(), u(), u()).normalize());
+                let expected = plain.intersect(&ray);
+                let mut counts = [TraversalCounts::default(); 2];
+                let found = boxed.intersect_counting(&ray, &mut counts[0]);
+                cell_boxes_only.intersect_counting(&ray, &mut counts[1]);
+                let portable = boxed.intersect_portable::<false, 0, true>(&ray, &mut ());
+                for got in [found, portable] {
+                    assert_eq!(got.map(|h| h.t), expected.map(|h| h.t), "ray {k}");
+                    if let (Some(got), Some(expected)) = (got, expected)
+                        && got.triangle != expected.triangle
+                    {
+                        let other = triangles[got.triangle as usize].intersect(&ray, f32::INFINITY);
+                        assert_eq!(other.map(|h| h.t), Some(expected.t), "ray {k}");
+                    }
+                }
+                hits += usize::from(expected.is_some());
+                for (tests, counts) in tests.iter_mut().zip(counts) {
+                    *tests += counts.tests;
+                }
+                ray.t_max = 1.5;
+                let blocked = plain.occluded(&ray);
+                assert_eq!(boxed.occluded(&ray), blocked, "ray {k}");
+                let portable = boxed.occluded_portable::<false, 0, true>(&ray, &mut ());
+                assert_eq!(portable, blocked, "ray {k}");
+            }
+            assert!(hits > 5_000, "{hits} hits");
+            assert!(
+                tests[0] * 10 < tests[1] * 8,
+                "density {density}: tests {tests:?}"
+            );
+        }
     }
 
     /// A ray whose direction is tiny (as a ray carried into the space of a hugely scaled
