@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use super::block::{Block, LANES};
 use super::block_order::{self, CellRun};
-use super::cell_box;
+use super::cell_box::{self, Kept};
 use super::cell_order::{Buckets, CellOrder, KeyParts};
 use super::cells::{CellIndex, MACRO_CELLS};
 use super::mesh_triangles::MeshTriangles;
@@ -20,7 +20,7 @@ use crate::scene::Aabb;
 /// Which grids keep boxes per cell and per block ([`cell_box`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Boxes {
-    /// Those whose blocks outgrow the caches ([`cell_box::boxed_for`]).
+    /// Those whose blocks outgrow the caches ([`cell_box::boxes_for`]).
     BySize,
     /// Every grid (for tests).
     #[cfg_attr(not(test), allow(dead_code))]
@@ -181,9 +181,14 @@ impl Grid {
         // Boxes per cell and per block ([`cell_box`]) for a grid whose blocks outgrow the
         // caches, each block's found as it is written, while its triangles are at hand; the
         // triangles of its cells of more than one block in Morton order ([`block_order`]).
-        let block_bytes = cells.block_count() * std::mem::size_of::<Block>();
-        let margin = cell_box::margin_for(&self.frame)
-            .filter(|_| boxes == Boxes::Always || cell_box::boxed_for(block_bytes));
+        let kept = match boxes {
+            Boxes::BySize => {
+                cell_box::boxes_for(cells.block_count() * std::mem::size_of::<Block>())
+            }
+            Boxes::Always => Kept::CellsAndBlocks,
+        };
+        let margin = cell_box::margin_for(&self.frame).filter(|_| kept != Kept::None);
+        let masked = margin.is_some() && kept == Kept::CellsAndBlocks;
         let mut crowded: Vec<CellRun> = Vec::new();
         let mut start = 0u32;
         for (mi, macrocell) in counts.chunks(MACRO_CELLS).enumerate() {
@@ -195,7 +200,7 @@ impl Grid {
                 for first in (0..count).step_by(LANES) {
                     runs.push((start + first, (count - first).min(LANES as u32), cell));
                 }
-                if margin.is_some() && count > LANES as u32 {
+                if masked && count > LANES as u32 {
                     crowded.push((start, count, cell));
                 }
                 start += count;
@@ -227,7 +232,7 @@ impl Grid {
                 .collect();
             self.cells.set_cell_boxes(boxes, margin);
         }
-        if boxed {
+        if masked {
             self.block_boxes = words;
         }
         true

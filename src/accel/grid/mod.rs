@@ -137,14 +137,11 @@ impl Grid {
         if self.cells.block_count() != self.blocks.len() {
             return Err("offsets and blocks disagree in length".into());
         }
-        let block_boxes = match self.cells.box_margin() {
-            Some(_) => self.blocks.len(),
-            None => 0,
-        };
-        if self.block_boxes.len() != block_boxes {
+        let boxes = self.block_boxes.len();
+        if boxes != 0 && (boxes != self.blocks.len() || self.cells.box_margin().is_none()) {
             return Err(format!(
-                "{} block boxes for {block_boxes}",
-                self.block_boxes.len()
+                "{boxes} block boxes for {} blocks",
+                self.blocks.len()
             ));
         }
         if self.blocks.iter().any(|b| b.len() == 0)
@@ -188,7 +185,7 @@ impl Grid {
                         {
                             return Err(format!("cell {c}'s box does not hold triangle {id}"));
                         }
-                        if let Some((_, margin)) = boxed
+                        if let Some((_, margin)) = boxed.filter(|_| boxes != 0)
                             && !cell_box::holds(
                                 &self.frame,
                                 c.as_ivec3(),

@@ -44,6 +44,7 @@ impl Grid {
             last_record: usize::MAX,
             pause_ahead: walk.is_some_and(|w| w.from_outside),
             box_margin: self.cells.box_margin().unwrap_or(Vec3A::ZERO),
+            masked: !self.block_boxes.is_empty(),
         }
     }
 }
@@ -63,6 +64,12 @@ impl Grid {
             next: MASKED_BLOCKS,
         }
     }
+}
+
+/// The mask of every one of `count` blocks ([`Found`]).
+#[inline(always)]
+fn every_block(count: usize) -> u64 {
+    u64::MAX >> (MASKED_BLOCKS - count.clamp(1, MASKED_BLOCKS))
 }
 
 /// The blocks of a cell to test ([`Grid::cell_blocks`]).
@@ -124,6 +131,8 @@ pub(super) struct OccupiedCells<
     pause_ahead: bool,
     /// How far each cell's box is grown, if `BOXED` ([`cell_box::margin_for`]).
     box_margin: Vec3A,
+    /// True when the grid keeps a box per block as well ([`cell_box::block_mask`]).
+    masked: bool,
 }
 
 /// How far the walk ahead of the cell being tested went.
@@ -180,8 +189,7 @@ impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32, const BOXED: b
             stats.visit_occupied();
             // Every hit belongs to the one cell.
             let all = grid.blocks.len();
-            let mask = u64::MAX >> (MASKED_BLOCKS - all.clamp(1, MASKED_BLOCKS));
-            return Some((0..all, mask, f32::INFINITY));
+            return Some((0..all, every_block(all), f32::INFINITY));
         }
         let current = match self.ahead.take() {
             Some(Ahead::Found(found)) => found,
@@ -260,11 +268,11 @@ impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32, const BOXED: b
                             let meets = cell_box::meets(walk, word, self.box_margin);
                             let keep = usize::from(meets).wrapping_neg();
                             let range = range.start..range.start + (range.len() & keep);
-                            let mask = if range.len() > 1 {
+                            let mask = if range.len() > 1 && self.masked {
                                 let words = &grid.block_boxes;
                                 cell_box::block_mask(walk, words, range.clone(), self.box_margin)
                             } else {
-                                range.len() as u64
+                                every_block(range.len())
                             };
                             (range, mask)
                         } else {

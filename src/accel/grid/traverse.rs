@@ -583,7 +583,7 @@ mod tests {
     }
 
     /// A grid that keeps a box per occupied cell (as a grid whose blocks outgrow the caches
-    /// does, [`super::super::cell_box::boxed_for`]) is valid, passes cells by their boxes,
+    /// does, [`super::super::cell_box::boxes_for`]) is valid, passes cells by their boxes,
     /// and finds exactly what the same grid without boxes finds, in both walks, with
     /// reaches per cell and per 2³ unit, for rays from outside and from among the cells,
     /// rays of huge and tiny direction vectors, and shadow segments; and a box that does
@@ -599,7 +599,6 @@ mod tests {
             unboxed.cells.fill_reaches(unit);
             let mut boxed = unboxed.clone();
             boxed.cells.set_cell_boxes(boxed.cell_boxes(), margin);
-            boxed.block_boxes = boxed.block_box_words();
             boxed.validate().unwrap();
             let (mut hits, mut tests) = (0, [0, 0]);
             for k in 0..20_000 {
@@ -642,7 +641,6 @@ mod tests {
         let middle = boxes.len() / 2;
         boxes[middle] = cell_box::encode(Vec3::ZERO, Vec3::splat(0.01));
         broken.cells.set_cell_boxes(boxes, margin);
-        broken.block_boxes = broken.block_box_words();
         let error = broken.validate().unwrap_err();
         assert!(error.contains("box does not hold"), "{error}");
     }
