@@ -31,6 +31,14 @@
 //! (`BOXED`), and grids whose blocks fit in the caches keep no boxes ([`BOXED_BLOCKS`]):
 //! there a block costs no more than the test, and the 11k dragon lost 1–12 % with boxes
 //! (docs/grid.md, twenty-sixth session).
+//!
+//! Grids whose blocks outgrow even the last-level cache ([`MASKED_BLOCKS_FROM`]) keep each
+//! block's word too, and order the triangles of each cell of several blocks so that a
+//! block's eight lie together ([`super::block_order`]). When the walk finds such a cell
+//! whose box the ray meets, it tests the boxes of its blocks ([`block_mask`]) and asks
+//! memory for, and tests, only the blocks whose boxes the ray meets (thirty-first
+//! session). Answers are again those of the grid without boxes, but for ties between equal
+//! hits, which the order within a cell decides.
 
 use std::ops::Range;
 

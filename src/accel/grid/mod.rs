@@ -8,9 +8,11 @@
 //! a cell's triangles are one contiguous read and are tested eight at a time ([`block`]).
 //! Empty macrocells know how far empty space reaches from them towards each octant of
 //! directions ([`reach`]), and empty cells of occupied macrocells the same at the level of
-//! cells ([`cell_reach`]), so the walk leaps over empty space. Traversal is the
-//! 3D-DDA of Amanatides & Woo (1987), accepting a hit only if it lies within the current
-//! cell.
+//! cells ([`cell_reach`]), so the walk leaps over empty space. Large grids keep boxes of
+//! each occupied cell's triangles, and the largest of each block's, so the walk passes cells
+//! and blocks the ray cannot meet there without reading them ([`cell_box`]). Traversal is
+//! the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if it lies within the
+//! current cell.
 
 mod block;
 mod block_order;
