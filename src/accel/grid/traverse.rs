@@ -338,6 +338,20 @@ mod tests {
     use super::*;
     use crate::accel::Triangle;
 
+    /// Asserts that `grid` answers the shadow query of ray `k` as `expected` does, in its
+    /// fast walk and in its portable one (reaches per 2^`UNIT` cells, boxes if `BOXED`).
+    fn assert_same_occlusion<const UNIT: u32, const BOXED: bool>(
+        expected: &Grid,
+        grid: &Grid,
+        ray: &Ray,
+        k: usize,
+    ) {
+        let blocked = expected.occluded(ray);
+        assert_eq!(grid.occluded(ray), blocked, "ray {k}");
+        let portable = grid.occluded_portable::<false, UNIT, BOXED>(ray, &mut ());
+        assert_eq!(portable, blocked, "ray {k}");
+    }
+
     /// A sphere of radius 1 at the origin, `n` × 2`n` quads split in two.
     fn sphere(n: usize) -> Vec<Triangle> {
         let at = |i: usize, j: usize| {
@@ -572,10 +586,7 @@ mod tests {
                 *leaps += counts.cell_leaps;
             }
             ray.t_max = 1.5;
-            let blocked = per_cell.occluded(&ray);
-            assert_eq!(per_unit.occluded(&ray), blocked, "ray {k}");
-            let portable = per_unit.occluded_portable::<false, 1, false>(&ray, &mut ());
-            assert_eq!(portable, blocked, "ray {k}");
+            assert_same_occlusion::<1, false>(&per_cell, &per_unit, &ray, k);
         }
         assert!(hits > 5_000, "{hits} hits");
         // Both walks leave cubes of cells.
@@ -623,13 +634,10 @@ mod tests {
                     *tests += counts.tests;
                 }
                 ray.t_max = 1.5 / scale;
-                let blocked = unboxed.occluded(&ray);
-                assert_eq!(boxed.occluded(&ray), blocked, "ray {k}");
-                let portable = match unit {
-                    0 => boxed.occluded_portable::<false, 0, true>(&ray, &mut ()),
-                    _ => boxed.occluded_portable::<false, 1, true>(&ray, &mut ()),
-                };
-                assert_eq!(portable, blocked, "ray {k}");
+                match unit {
+                    0 => assert_same_occlusion::<0, true>(&unboxed, &boxed, &ray, k),
+                    _ => assert_same_occlusion::<1, true>(&unboxed, &boxed, &ray, k),
+                }
             }
             assert!(hits > 5_000, "{hits} hits");
             // The boxes spare a good share of the triangle tests.
@@ -692,10 +700,7 @@ mod tests {
                     *tests += counts.tests;
                 }
                 ray.t_max = 1.5;
-                let blocked = plain.occluded(&ray);
-                assert_eq!(boxed.occluded(&ray), blocked, "ray {k}");
-                let portable = boxed.occluded_portable::<false, 0, true>(&ray, &mut ());
-                assert_eq!(portable, blocked, "ray {k}");
+                assert_same_occlusion::<0, true>(&plain, &boxed, &ray, k);
             }
             assert!(hits > 5_000, "{hits} hits");
             assert!(
