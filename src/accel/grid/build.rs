@@ -151,8 +151,9 @@ impl Grid {
     /// ([`cell_order`], in parallel over parts of the grid) lays them out in cell order, and
     /// the blocks are then written in parallel, each from its run of that list, straight
     /// into their final place (no pass over the whole block array before it is filled).
-    /// Within a cell, triangles keep mesh order whatever the thread count, so ties between
-    /// equal hits resolve the same way. False, with nothing changed, if there are more
+    /// Within a cell, triangles keep mesh order (in a grid that keeps boxes per block, Morton
+    /// order with ties in mesh order, [`block_order`]) whatever the thread count, so ties
+    /// between equal hits resolve the same way. False, with nothing changed, if there are more
     /// references than 32-bit offsets hold.
     fn insert(&mut self, triangles: MeshTriangles, live: &[u32], boxes: Boxes) -> bool {
         let m = CellIndex::macro_resolution_for(self.frame.resolution);

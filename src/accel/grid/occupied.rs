@@ -47,9 +47,7 @@ impl Grid {
             masked: !self.block_boxes.is_empty(),
         }
     }
-}
 
-impl Grid {
     /// The blocks of an occupied cell that its walk gives out ([`Found`]): for a grid that
     /// keeps boxes, those of `range` that `mask` holds, then any after the first 64.
     #[inline(always)]
