@@ -48,8 +48,9 @@ pub struct Grid {
     cells: CellIndex,
     /// The triangles of every occupied cell, eight to a block, cell after cell.
     blocks: Vec<Block>,
-    /// For a grid that keeps boxes ([`cell_box`]), each block's box word within its cell, so
-    /// the walk tests only the blocks of a cell whose boxes the ray meets; empty otherwise.
+    /// For a grid whose blocks outgrow the last-level cache ([`cell_box::boxes_for`]), each
+    /// block's box word within its cell, so the walk tests only the blocks of a cell whose
+    /// boxes the ray meets; empty otherwise.
     block_boxes: Vec<u32>,
     /// Triangle references in `blocks` (lanes in use).
     references: usize,
@@ -168,7 +169,7 @@ impl Grid {
                     let stored = range.flat_map(|k| {
                         (0..block::LANES).filter_map(move |l| self.blocks[k].get(l).map(|s| (k, s)))
                     });
-                    for (in_block, (triangle, id)) in stored {
+                    for (block_number, (triangle, id)) in stored {
                         let id = id as usize;
                         let b = triangle.bounds();
                         if id >= self.triangle_count {
@@ -191,13 +192,13 @@ impl Grid {
                             && !cell_box::holds(
                                 &self.frame,
                                 c.as_ivec3(),
-                                self.block_boxes[in_block],
+                                self.block_boxes[block_number],
                                 margin,
                                 &triangle,
                             )
                         {
                             return Err(format!(
-                                "block {in_block}'s box does not hold triangle {id}"
+                                "block {block_number}'s box does not hold triangle {id}"
                             ));
                         }
                         seen[id] = true;
