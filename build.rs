@@ -1,4 +1,4 @@
-//! Development-only linking of Embree 4: when `tools/install-embree.sh` has put the library
+//! Development-only linking of Embree 4: when `tools/dev/install-embree.sh` has put the library
 //! in `.embree4/`, the tests and benchmarks (which use it as an oracle) link
 //! against it and find it at run time through an rpath. The renderer itself never does.
 

@@ -19,7 +19,7 @@
 //! that are blocked and those that pass), each part timed alone, and the grid's speed-up on
 //! all threads (bounce rays, each timing about 0.2 s long).
 //!
-//! Run with `cargo bench --bench accel` after `tools/setup-dev.sh`. Environment:
+//! Run with `cargo bench --bench accel` after `tools/dev/setup.sh`. Environment:
 //! `ACCEL_BENCH_MODELS` (comma-separated files of data/dragon, default the smallest, a
 //! middle one and the full dragon), `ACCEL_BENCH_RAYS` (rays per set, default 100,000),
 //! `ACCEL_BENCH_RUNS` (default 5), `ACCEL_BENCH_DENSITY` (the grid's cells per triangle).

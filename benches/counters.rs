@@ -1,11 +1,11 @@
 //! One structure's queries on one ray set, for a processor simulator to count: the grid or
 //! Embree 4 over a dragon, the rays traced once to settle the caches and then once more in
-//! [`counted_pass`], the function `tools/accel-counters.sh` tells callgrind to count in
+//! [`counted_pass`], the function `tools/dev/accel-counters.sh` tells callgrind to count in
 //! (instructions, simulated cache misses and mispredicted branches). This machine's
 //! processor exposes no counters of its own (`perf stat`: cycles not supported), so these
 //! simulated ones are where a query's work is counted; the times stay `benches/accel.rs`'s.
 //!
-//! Not a timing: run under `tools/accel-counters.sh`. Environment: `COUNTERS_MODEL` (a file
+//! Not a timing: run under `tools/dev/accel-counters.sh`. Environment: `COUNTERS_MODEL` (a file
 //! of data/dragon, default the full dragon), `COUNTERS_STRUCTURE` (`grid` or `embree`),
 //! `COUNTERS_SET` (`outside`, `camera`, `bounce`, `shadow` or `light`), `COUNTERS_RAYS` (default
 //! 10,000).

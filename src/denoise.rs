@@ -43,7 +43,7 @@ pub enum DenoiseError {
     #[error(
         "--denoise needs Intel Open Image Denoise 2 ({LIBRARY_NAME}), which was not found \
          ({tried}); install it (`pip install pyoidn` ships it in pyoidn/oidn/lib, or the \
-         project's tools/install-oidn.sh) and point {LIBRARY_VARIABLE} at the library or \
+         project's tools/user/install-oidn.sh) and point {LIBRARY_VARIABLE} at the library or \
          its folder"
     )]
     NotInstalled {

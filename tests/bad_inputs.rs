@@ -1,4 +1,4 @@
-//! Every file in the corpus `tests/bad/` (made by `tools/make_bad_inputs.py`) gives its
+//! Every file in the corpus `tests/bad/` (made by `tools/dev/make_bad_inputs.py`) gives its
 //! exact outcome: a one-line error naming the file and the problem with exit code 2, or a
 //! warning naming it and a rendered image. Nothing panics, hangs or writes a partial image.
 

@@ -1,7 +1,7 @@
 //! Denoising against Cycles' references: at 16 samples per pixel, Open Image Denoise guided
 //! by gridtrace's albedo and normal layers must cut the error at least five-fold.
 //!
-//! Needs the OIDN 2 library (`tools/install-oidn.sh`, which the test command runs, puts it
+//! Needs the OIDN 2 library (`tools/user/install-oidn.sh`, which the test command runs, puts it
 //! in `.oidn/lib`); without it the test says so and passes.
 
 mod image_stats;
@@ -64,7 +64,7 @@ fn display_rmse(image: &[Vec3], reference: &[DVec3]) -> f64 {
 fn denoising_16_spp_cuts_the_error_against_cycles_five_fold() {
     let Some(library) = library() else {
         eprintln!(
-            "skipped: Open Image Denoise 2 is not installed (run tools/install-oidn.sh or set \
+            "skipped: Open Image Denoise 2 is not installed (run tools/user/install-oidn.sh or set \
              GRIDTRACE_OIDN)"
         );
         return;

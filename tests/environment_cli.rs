@@ -49,7 +49,7 @@ fn mean(pixels: &[[f32; 4]]) -> f64 {
 }
 
 /// Files written by other tools (trimesh, pygltflib, Pixar's USD library; see
-/// `tools/make_third_party.py`), with no light and no camera, come out lit, framed and with
+/// `tools/dev/make_third_party.py`), with no light and no camera, come out lit, framed and with
 /// the note that says how.
 #[test]
 fn models_without_lights_or_camera_render_visibly_with_a_note() {

@@ -106,10 +106,10 @@ fn one_animation_can_be_chosen_and_an_unknown_one_is_an_error() {
 /// translation keys) without a bufferView, the zero-filled form; the pose is the same.
 #[test]
 fn sparse_rewrites_pose_the_same() {
-    let tools = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/npm/node_modules/.bin");
+    let tools = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/dev/npm/node_modules/.bin");
     assert!(
         tools.join("gltf-transform").exists(),
-        "glTF-Transform is missing: run tools/setup-dev.sh"
+        "glTF-Transform is missing: run tools/dev/setup.sh"
     );
     let dir = tempfile::tempdir().unwrap();
     let sparse = dir.path().join("sparse.glb");

@@ -14,7 +14,7 @@ use gridtrace::load::load_scene;
 use serde_json::{Value, json};
 
 /// Writes `document` with `buffer` as its only buffer, in a base64 data URI, and checks it
-/// with Khronos' glTF-Validator (`tools/npm`, installed by `tools/setup-dev.sh`).
+/// with Khronos' glTF-Validator (`tools/dev/npm`, installed by `tools/dev/setup.sh`).
 fn write(dir: &Path, name: &str, buffer: &[u8], document: Value) -> PathBuf {
     let path = write_unchecked(dir, name, buffer, document);
     common::validate_gltf(&path);

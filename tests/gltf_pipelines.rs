@@ -21,7 +21,7 @@
 //! keeps the colour under alpha 0 only with its `exact` option, which glTF-Transform leaves
 //! off (the only such texture here is a cutout's, where the colour is never seen).
 //!
-//! The tools come from `tools/setup-dev.sh` (`npm ci` in `tools/npm`).
+//! The tools come from `tools/dev/setup.sh` (`npm ci` in `tools/dev/npm`).
 
 mod common;
 mod image_stats;
@@ -39,10 +39,10 @@ use world::{corners, farthest, world_triangles};
 const SPP: u32 = 64;
 
 fn npm_tools() -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/npm");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/dev/npm");
     assert!(
         dir.join("node_modules/.bin/gltf-transform").exists(),
-        "glTF-Transform is missing: run tools/setup-dev.sh (npm ci in tools/npm)"
+        "glTF-Transform is missing: run tools/dev/setup.sh (npm ci in tools/dev/npm)"
     );
     dir
 }

@@ -1,4 +1,4 @@
-//! The hostile-input corpus (made at test time by `tools/make_hostile_inputs.py`, since it
+//! The hostile-input corpus (made at test time by `tools/dev/make_hostile_inputs.py`, since it
 //! needs a FIFO, a symbolic link and a sparse 3 GB file): every case ends in a one-line
 //! error naming the file, or a warning naming it and an image, within a minute and within
 //! a 2 GiB address-space limit (`setrlimit` in the child, so an allocation past it fails
@@ -20,7 +20,7 @@ use gridtrace::output::read_exr_rgba;
 const MEMORY_LIMIT: u64 = 2 << 30;
 /// Longest any run may take.
 const TIME_LIMIT: Duration = Duration::from_secs(60);
-/// The secret outside the scenes' folder (tools/make_hostile_inputs.py writes it).
+/// The secret outside the scenes' folder (tools/dev/make_hostile_inputs.py writes it).
 const SECRET: &[u8] = b"TOPSECRET-canary-7f3a-gridtrace-hostile-input-corpus!!!!";
 
 enum Expect {
@@ -204,11 +204,11 @@ fn corpus() -> &'static Path {
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("hostile-corpus");
         let _ = std::fs::remove_dir_all(&dir);
         let status = Command::new("python3")
-            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/make_hostile_inputs.py"))
+            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/dev/make_hostile_inputs.py"))
             .arg(&dir)
             .status()
-            .expect("python3 runs tools/make_hostile_inputs.py");
-        assert!(status.success(), "tools/make_hostile_inputs.py failed");
+            .expect("python3 runs tools/dev/make_hostile_inputs.py");
+        assert!(status.success(), "tools/dev/make_hostile_inputs.py failed");
         dir
     })
 }
@@ -475,7 +475,7 @@ fn films_and_parts_larger_than_memory_are_refused_before_allocation() {
     assert_eq!(run_limited(&small, &scenes).code, Some(0));
     let claiming = out.path().join("claims-16384.exr");
     let status = Command::new("python3")
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/make_hostile_inputs.py"))
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/dev/make_hostile_inputs.py"))
         .args([
             "--exr-claiming",
             part.to_str().unwrap(),

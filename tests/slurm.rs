@@ -1,10 +1,10 @@
 //! The Slurm recipe end to end: starts a real single-node Slurm on this machine
-//! (tools/slurm/local-cluster.sh), submits the bundled Cornell box as a job array of four
-//! sample ranges and a dependent merge (tools/slurm/submit.sh), and checks the merged image
+//! (tools/user/slurm/local-cluster.sh), submits the bundled Cornell box as a job array of four
+//! sample ranges and a dependent merge (tools/user/slurm/submit.sh), and checks the merged image
 //! against one process rendering all the samples. The daemons it started are stopped by pid
 //! whatever happens.
 //!
-//! Needs root and the Slurm and munge packages (tools/install-slurm.sh, run by the test
+//! Needs root and the Slurm and munge packages (tools/dev/install-slurm.sh, run by the test
 //! command). Where neither can be had, `GRIDTRACE_SKIP_SLURM=1` skips it, saying so.
 
 use std::path::{Path, PathBuf};
@@ -29,14 +29,14 @@ struct Cluster {
 impl Cluster {
     fn start(dir: PathBuf) -> Cluster {
         let cluster = Cluster { dir };
-        let out = Command::new(repo().join("tools/slurm/local-cluster.sh"))
+        let out = Command::new(repo().join("tools/user/slurm/local-cluster.sh"))
             .arg("start")
             .arg(&cluster.dir)
             .output()
-            .expect("run tools/slurm/local-cluster.sh");
+            .expect("run tools/user/slurm/local-cluster.sh");
         assert!(
             out.status.success(),
-            "starting Slurm failed (run tools/install-slurm.sh as root, or set \
+            "starting Slurm failed (run tools/dev/install-slurm.sh as root, or set \
              GRIDTRACE_SKIP_SLURM=1 where Slurm cannot run):\n{}",
             String::from_utf8_lossy(&out.stderr)
         );
@@ -90,7 +90,7 @@ impl Cluster {
 
 impl Drop for Cluster {
     fn drop(&mut self) {
-        let _ = Command::new(repo().join("tools/slurm/local-cluster.sh"))
+        let _ = Command::new(repo().join("tools/user/slurm/local-cluster.sh"))
             .arg("stop")
             .arg(&self.dir)
             .status();
@@ -126,7 +126,7 @@ fn a_four_task_slurm_array_merges_to_the_single_process_render() {
     let merged = work.path().join("slurm.exr");
     let start = Instant::now();
     let out = cluster
-        .command(repo().join("tools/slurm/submit.sh"))
+        .command(repo().join("tools/user/slurm/submit.sh"))
         .env("GRIDTRACE", gridtrace)
         .args(["--tasks", &TASKS.to_string(), "--spp", &SPP.to_string()])
         .arg(&scene)

@@ -1,5 +1,5 @@
 //! USD as studios and Apple's tools write it, checked against the answers Pixar's own
-//! library computes for the same stages (`tools/make_usd_pipeline.py` writes both: the
+//! library computes for the same stages (`tools/dev/make_usd_pipeline.py` writes both: the
 //! stages under `tests/scenes/usd_pipeline/` and a JSON file of answers beside each).
 
 mod image_stats;

@@ -428,7 +428,7 @@ fn first_exit(t: Vec3A) -> (Vec3A, BVec3A) {
 
 /// `a·b + c` in each lane: with `FUSED`, one fused multiply-add (rounded once, and a step
 /// shorter on the walk's chain of dependent operations: the warm queries of the full dragon
-/// 0.97–0.99 the time, `tools/grid-ab.sh` with `GRID_AB_CHUNK=250`), else a multiply and an
+/// 0.97–0.99 the time, `tools/dev/grid-ab.sh` with `GRID_AB_CHUNK=250`), else a multiply and an
 /// add. `FUSED` is set only by the grid's queries compiled with the `fma` feature, chosen
 /// at run time on processors that have it ([`crate::accel::cpu::x86_level`]); elsewhere it
 /// is false.

@@ -53,22 +53,22 @@ pub fn quad_buffer() -> Vec<u8> {
 }
 
 /// Writes `document` as `name` (and the quad buffer beside it) into `dir`, and checks it
-/// with Khronos' glTF-Validator (`tools/npm`, installed by `tools/setup-dev.sh`).
+/// with Khronos' glTF-Validator (`tools/dev/npm`, installed by `tools/dev/setup.sh`).
 pub fn write_gltf(dir: &Path, name: &str, document: &Value) -> PathBuf {
     let path = write_unchecked_gltf(dir, name, document);
     validate_gltf(&path);
     path
 }
 
-/// Panics with the report unless Khronos' glTF-Validator (`tools/npm/validate.mjs`,
-/// installed by `tools/setup-dev.sh`) finds no error in the file at `path`.
+/// Panics with the report unless Khronos' glTF-Validator (`tools/dev/npm/validate.mjs`,
+/// installed by `tools/dev/setup.sh`) finds no error in the file at `path`.
 pub fn validate_gltf(path: &Path) {
-    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/npm/validate.mjs");
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/dev/npm/validate.mjs");
     let out = std::process::Command::new("node")
         .arg(validator)
         .arg(path)
         .output()
-        .expect("node runs (tools/setup-dev.sh)");
+        .expect("node runs (tools/dev/setup.sh)");
     assert!(
         out.status.success(),
         "{}{}",

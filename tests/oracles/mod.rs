@@ -14,7 +14,7 @@ use gridtrace::accel::{Ray, Triangle};
 use obvhs::BvhBuildParams;
 use obvhs::cwbvh::CwBvh;
 
-/// The dragon models `tools/fetch-dragon.sh` unpacks, finest first.
+/// The dragon models `tools/dev/fetch-dragon.sh` unpacks, finest first.
 pub const DRAGON_MODELS: [&str; 4] = [
     "dragon_vrip.ply.gz",
     "dragon_vrip_res2.ply.gz",
@@ -29,7 +29,7 @@ pub fn dragon_path(model: &str) -> PathBuf {
         .join(model);
     assert!(
         path.is_file(),
-        "{} is missing: run tools/setup-dev.sh (or tools/test.sh)",
+        "{} is missing: run tools/dev/setup.sh (or tools/test.sh)",
         path.display()
     );
     path

@@ -68,7 +68,7 @@ pub fn segments(rays: &[Ray], max_length: f32, seed: u64) -> Vec<Ray> {
 /// Shadow segments as the renderer's light sampling makes them: from uniform random points of
 /// random triangles ([`surface_point`]) whose outward side (the winding's, `e1 × e2`) faces a square light above the
 /// box, towards a uniform random point of the light ([`light_segment`]). (For the benchmark
-/// and `tools/grid-ab`; the cross-check does not use them.)
+/// and `tools/dev/grid-ab`; the cross-check does not use them.)
 #[allow(dead_code)]
 pub fn light_segments(triangles: &[Triangle], bounds: &Aabb, count: usize, seed: u64) -> Vec<Ray> {
     let mut rng = Rng::new(seed, 4);
@@ -86,7 +86,7 @@ pub fn light_segments(triangles: &[Triangle], bounds: &Aabb, count: usize, seed:
 /// segment from its hit on the side it sees, when that side faces the light: the order in
 /// which the renderer traces them, so that the segment starts in cells the camera ray has
 /// just read. `nearest` gives a ray's hit: parameter, barycentrics `u`, `v` and triangle.
-/// (For `tools/grid-ab`'s `seen` set, which times each pair together.)
+/// (For `tools/dev/grid-ab`'s `seen` set, which times each pair together.)
 #[allow(dead_code)]
 pub fn seen_light_pairs(
     triangles: &[Triangle],
@@ -143,7 +143,7 @@ fn light_segment(
 }
 
 /// A pinhole camera's rays: from one point framing the box, through a square image. (For
-/// the benchmark and `tools/grid-ab`; the cross-check does not use them.)
+/// the benchmark and `tools/dev/grid-ab`; the cross-check does not use them.)
 #[allow(dead_code)]
 pub fn camera_rays(bounds: &Aabb, count: usize) -> Vec<Ray> {
     let center = bounds.center();

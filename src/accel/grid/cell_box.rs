@@ -18,7 +18,7 @@
 //! cell lies in another cell along the ray, which holds the triangle too (the grid's exact
 //! hit-in-cell rule), so answers are bit for bit those of the grid without boxes.
 //!
-//! On the full dragon, against the grid without boxes (`tools/grid-ab.sh a75f5a5
+//! On the full dragon, against the grid without boxes (`tools/dev/grid-ab.sh a75f5a5
 //! dragon_vrip.ply.gz outside,camera,bounce,shadow,light 7`, identical answers), time of
 //! outside / camera / bounce / shadow / light rays: 0.91 / 1.00 / 0.94 / 0.92 / 0.94 in
 //! chunks of 10,000 rays, 0.93 / 0.98 / 0.95 / 0.95 / 0.93 in cache (`GRID_AB_CHUNK=250`).

@@ -303,7 +303,7 @@ impl Grid {
     /// leaves, whose cells are crowded with triangles that seldom block it, and ends on a
     /// light or beyond the box: walked from that end, a blocked segment stops at the
     /// blocker nearest the end without testing them. Against the forward walk, identical
-    /// answers (`tools/grid-ab.sh`, 50,000 segments each): light segments 0.61–0.64 the
+    /// answers (`tools/dev/grid-ab.sh`, 50,000 segments each): light segments 0.61–0.64 the
     /// time on the full dragon, 0.73 on the 203k, 0.95 on the 11k; the bounce rays cut to
     /// random lengths 0.81, 0.88 and 1.01; light segments from a camera's hits, each traced
     /// after its camera ray (set `seen`), 0.94 on the full dragon and 1.00 on the 11k.

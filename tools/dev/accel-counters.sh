@@ -5,8 +5,8 @@
 # benches/counters.rs's `counted_pass`). For where a query's time goes on a machine whose
 # processor exposes no counters (`perf stat -e cycles true`: not supported).
 #
-#   tools/accel-counters.sh [MODEL] [SETS]
-#   tools/accel-counters.sh dragon_vrip.ply.gz outside,bounce
+#   tools/dev/accel-counters.sh [MODEL] [SETS]
+#   tools/dev/accel-counters.sh dragon_vrip.ply.gz outside,bounce
 #
 # The simulated caches are this machine's per core: 32 KiB of L1 data (8-way), and as the
 # last level the 2 MiB L2 (16-way) — the L3 is shared with other machines and holds little

@@ -1,8 +1,8 @@
 """Write the hostile-input corpus into a folder: scenes that try to read outside their
 folder, block, exhaust memory or time, or describe impossible cameras and materials.
 
-Run: python3 tools/make_hostile_inputs.py OUT
-     python3 tools/make_hostile_inputs.py --exr-claiming PART.exr SIZE OUT.exr
+Run: python3 tools/dev/make_hostile_inputs.py OUT
+     python3 tools/dev/make_hostile_inputs.py --exr-claiming PART.exr SIZE OUT.exr
 
 OUT/secret.txt and OUT/secret.usda lie outside the scenes' folder OUT/scenes/, which holds
 every scene; some cases need special files (a FIFO, a symbolic link, a sparse 3 GB file),
@@ -20,7 +20,7 @@ import struct
 import sys
 import zipfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from make_bad_inputs import QUAD, QUAD_INDICES, buffer_bytes, document  # noqa: E402
 
@@ -34,7 +34,7 @@ def quad_bytes():
 
 
 def gltf(buffer_uri="quad.bin", byte_length=60, **overrides):
-    """tools/make_bad_inputs.py's emissive quad, its buffer in the file `buffer_uri`."""
+    """tools/dev/make_bad_inputs.py's emissive quad, its buffer in the file `buffer_uri`."""
     doc = document(**overrides)
     doc["buffers"] = [{"uri": buffer_uri, "byteLength": byte_length}]
     return doc

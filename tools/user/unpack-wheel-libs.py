@@ -3,7 +3,7 @@
 libraries in one of its folders into a destination folder: how the development setup gets
 native libraries Debian does not package (Embree 4, Open Image Denoise 2).
 
-    python3 tools/unpack-wheel-libs.py REQUIREMENTS FOLDER_IN_WHEEL DEST [NAME_PREFIX...]
+    python3 tools/user/unpack-wheel-libs.py REQUIREMENTS FOLDER_IN_WHEEL DEST [NAME_PREFIX...]
 
 Only files whose names start with one of the NAME_PREFIXes are copied (all, if none given).
 """

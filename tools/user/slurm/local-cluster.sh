@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # A throwaway single-node Slurm cluster on this machine, for trying the job scripts and for
 # the test that runs them (tests/slurm.rs). Needs root and the Debian packages slurmctld,
-# slurmd, slurm-client and munge (tools/install-slurm.sh).
+# slurmd, slurm-client and munge (tools/dev/install-slurm.sh).
 #
-#   tools/slurm/local-cluster.sh start DIR   # config, logs and state in DIR; prints the
+#   tools/user/slurm/local-cluster.sh start DIR   # config, logs and state in DIR; prints the
 #                                            # SLURM_CONF line for sbatch/squeue
-#   tools/slurm/local-cluster.sh stop DIR    # stops the daemons it started, by pid
+#   tools/user/slurm/local-cluster.sh stop DIR    # stops the daemons it started, by pid
 #
 # Everything lives in DIR: munged gets its own socket there (the system's /run/munge is
 # created only because munged expects its default folders to exist), slurmctld and slurmd
@@ -34,7 +34,7 @@ stop() {
 
 start() {
   for tool in munged slurmctld slurmd sinfo; do
-    command -v "$tool" >/dev/null || { echo "$tool not found: run tools/install-slurm.sh" >&2; exit 1; }
+    command -v "$tool" >/dev/null || { echo "$tool not found: run tools/dev/install-slurm.sh" >&2; exit 1; }
   done
   [ "$(id -u)" -eq 0 ] || { echo "the local cluster runs its daemons as root" >&2; exit 1; }
   mkdir -p "$dir"

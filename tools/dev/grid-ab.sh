@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Times the grid of the working tree against the grid of another commit, in one process, on
-# the same dragon and the same rays (tools/grid-ab/main.rs says how). For measuring a change
+# the same dragon and the same rays (tools/dev/grid-ab/main.rs says how). For measuring a change
 # to the grid of a few per cent, which separate runs on a shared machine cannot resolve.
 #
-#   tools/grid-ab.sh BASE [MODEL] [SETS] [ROUNDS]
-#   tools/grid-ab.sh HEAD dragon_vrip.ply.gz outside,camera,bounce,shadow 5
+#   tools/dev/grid-ab.sh BASE [MODEL] [SETS] [ROUNDS]
+#   tools/dev/grid-ab.sh HEAD dragon_vrip.ply.gz outside,camera,bounce,shadow 5
 #
-# BASE is any commit; MODEL a file of data/dragon (tools/fetch-dragon.sh); SETS a
+# BASE is any commit; MODEL a file of data/dragon (tools/dev/fetch-dragon.sh); SETS a
 # comma-separated choice of outside, camera, bounce, shadow, light and seen (pairs: a camera
 # ray, then the light segment from its hit, traced in that order); GRID_AB_RAYS rays per set
 # (default 50,000); GRID_AB_CHUNK rays per chunk (default 10,000; a few hundred
@@ -18,7 +18,7 @@
 # ones only rebuild the two copies of gridtrace.
 set -euo pipefail
 root=$(git rev-parse --show-toplevel)
-base=${1:?usage: tools/grid-ab.sh BASE [MODEL] [SETS] [ROUNDS]}
+base=${1:?usage: tools/dev/grid-ab.sh BASE [MODEL] [SETS] [ROUNDS]}
 commit=$(git -C "$root" rev-parse --verify "$base^{commit}")
 work=$root/target/grid-ab
 rm -rf "$work/base" "$work/harness/src"
@@ -44,7 +44,7 @@ glam = "$glam"
 
 [workspace]
 TOML
-cp "$root/tools/grid-ab/main.rs" "$work/harness/src/main.rs"
+cp "$root/tools/dev/grid-ab/main.rs" "$work/harness/src/main.rs"
 cp "$root/tests/oracles/rays.rs" "$work/harness/src/rays.rs"
 cp "$root/Cargo.lock" "$work/harness/Cargo.lock"
 echo "grid-ab: this tree against $commit; building" >&2

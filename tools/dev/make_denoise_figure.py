@@ -2,9 +2,9 @@
 """The README's noisy-versus-denoised figure, docs/denoise.png: the bundled spheres scene at
 16 samples per pixel as rendered, then denoised (--denoise, guided by the albedo and normal
 layers), then at 4096 samples for comparison. Needs a release build, Open Image Denoise
-(tools/install-oidn.sh) and Pillow (pip install pillow).
+(tools/user/install-oidn.sh) and Pillow (pip install pillow).
 
-    python3 tools/make_denoise_figure.py
+    python3 tools/dev/make_denoise_figure.py
 """
 import os
 import subprocess
@@ -13,7 +13,7 @@ import tempfile
 
 from PIL import Image
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 GRIDTRACE = os.path.join(ROOT, "target", "release", "gridtrace")
 SCENE = os.path.join(ROOT, "assets", "cornell_spheres.glb")
 SIZE = "192"

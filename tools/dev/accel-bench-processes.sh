@@ -3,7 +3,7 @@
 # per model and ray set, the grid/Embree median of each process and the median and range
 # over the processes.
 #
-#   tools/accel-bench-processes.sh [PROCESSES]      (default 7)
+#   tools/dev/accel-bench-processes.sh [PROCESSES]      (default 7)
 #
 # Why: on the development VM the speed of all three structures changes from one process to
 # the next (Embree's on the full dragon's outside rays from 2.0 to 4.1 Mrays/s, the grid's

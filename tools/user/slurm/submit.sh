@@ -2,7 +2,7 @@
 # Submits one image to Slurm as K render tasks (a job array) and a merge that runs when
 # they have all succeeded. Prints the two job ids: "ARRAY_JOB_ID MERGE_JOB_ID".
 #
-#   tools/slurm/submit.sh [--tasks K] [--spp N] SCENE OUTPUT.exr [gridtrace options]
+#   tools/user/slurm/submit.sh [--tasks K] [--spp N] SCENE OUTPUT.exr [gridtrace options]
 #
 # Parts and logs go to OUTPUT.parts/ beside the output. Extra sbatch options (partition,
 # account, --cpus-per-task, …) go in $SBATCH_OPTIONS. The scene, the output folder and the

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs Slurm and munge from Debian for the cluster test (tests/slurm.rs), which starts
-# its own throwaway single-node cluster with tools/slurm/local-cluster.sh. The packages'
+# its own throwaway single-node cluster with tools/user/slurm/local-cluster.sh. The packages'
 # own services are not used. Idempotent.
 set -euo pipefail
 packages=(slurmctld slurmd slurm-client munge)

@@ -3,7 +3,7 @@
 //! chunks of 10,000 rays, the two taking each chunk in turn (the order alternating), best of
 //! 7 per chunk, the rounds' ratios sorted. One process removes the machine's drift between
 //! runs, which on the development machine moves separate runs by up to a tenth; the same
-//! code against itself gives 1.005 ± 0.015. Built and run by `tools/grid-ab.sh`, not part
+//! code against itself gives 1.005 ± 0.015. Built and run by `tools/dev/grid-ab.sh`, not part
 //! of the crate.
 
 mod rays;
@@ -31,7 +31,7 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(10_000);
-    let data = std::env::var("GRID_AB_DATA").expect("set by tools/grid-ab.sh");
+    let data = std::env::var("GRID_AB_DATA").expect("set by tools/dev/grid-ab.sh");
     let path = std::path::Path::new(&data).join(model);
     let (positions, indices) = gridtrace::load::ply::read_mesh(&path).expect("a readable mesh");
     // GRID_AB_DENSITY: this tree's grid at that many cells per triangle instead of the

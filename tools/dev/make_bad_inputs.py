@@ -1,6 +1,6 @@
 """Write the corpus of broken and hostile scene files in tests/bad/.
 
-Run from the repository root: python3 tools/make_bad_inputs.py
+Run from the repository root: python3 tools/dev/make_bad_inputs.py
 Each file is small and made here from scratch (the truncated .glb is cut from the bundled
 Cornell box). tests/bad_inputs.rs says what gridtrace must do with each one.
 """
@@ -10,7 +10,7 @@ import json
 import os
 import struct
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 OUT = os.path.join(ROOT, "tests", "bad")
 
 QUAD = [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]
