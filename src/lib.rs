@@ -32,7 +32,6 @@ pub mod accel;
 pub mod cli;
 pub mod denoise;
 pub mod display;
-pub mod inspect;
 pub mod limits;
 pub mod load;
 pub mod merge;

@@ -55,8 +55,10 @@ pub struct RenderIdentity {
     pub seed: u64,
     /// Most scattering events along a path.
     pub max_depth: u32,
-    /// Loader options that change the scene, as text (glTF light units, USD frame).
-    pub load_options: String,
+    /// Every other option that changes a sample's value, as text: how the scene was read
+    /// (glTF light units, frame, animation, subdivision), the shutter, the environment and
+    /// the pixel filter. Kept under the key `loadOptions`, which files already written use.
+    pub options: String,
     /// `--exposure` in stops, applied to every output: parts merge only at equal exposure.
     pub exposure: f32,
     /// The auxiliary layers kept (`--aov`), comma-separated: parts merge only with the
@@ -109,7 +111,7 @@ impl RenderIdentity {
             ("height", self.height.to_string()),
             ("seed", self.seed.to_string()),
             ("maxDepth", self.max_depth.to_string()),
-            ("loadOptions", self.load_options.clone()),
+            ("loadOptions", self.options.clone()),
             ("exposure", self.exposure.to_string()),
             ("aovs", self.aovs.clone()),
         ]
@@ -183,7 +185,7 @@ impl RenderRecord {
                 height: small("height")?,
                 seed: number("seed")?,
                 max_depth: small("maxDepth")?,
-                load_options: text("loadOptions")?,
+                options: text("loadOptions")?,
                 // Records from before --exposure had none: 0 stops.
                 exposure: match text("exposure") {
                     Err(_) => 0.0,
@@ -343,7 +345,7 @@ mod tests {
                 height: 480,
                 seed: u64::MAX,
                 max_depth: 16,
-                load_options: "gltf-light-units=standard".into(),
+                options: "gltf-light-units=standard".into(),
                 exposure: -1.5,
                 aovs: "albedo,normal".into(),
             },

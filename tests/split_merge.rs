@@ -35,7 +35,7 @@ fn record(samples: Range<u32>, seed: u64) -> RenderRecord {
             height: SIZE,
             seed,
             max_depth: 8,
-            load_options: String::new(),
+            options: String::new(),
             exposure: 0.0,
             aovs: String::new(),
         },

@@ -674,7 +674,7 @@ fn references_and_instances_are_composed() {
     );
 }
 
-/// UsdPreviewSurface inputs as the README's material table maps them: the specular
+/// UsdPreviewSurface inputs as docs/manual/materials.md's table maps them: the specular
 /// workflow's F0, Blender's `specular` level, clear coat, and scalar inputs read from one
 /// channel of a texture with that channel's `scale`.
 #[test]

@@ -6,7 +6,7 @@ use glam::Vec3;
 use crate::scene::{Camera, Projection, Scene, ThinLens};
 
 /// Image height used when neither --width nor --height is given.
-const DEFAULT_HEIGHT: u32 = 512;
+pub const DEFAULT_HEIGHT: u32 = 512;
 
 /// How the record names a camera: its name and where it came from, and its lens.
 pub fn camera_label(camera: &Camera) -> String {
@@ -62,6 +62,76 @@ pub fn with_depth_of_field(
     camera
 }
 
+/// Which camera renders: one of the scene's, or one made to frame it. Chosen once, by
+/// name or index, and taken from whichever reading of the scene renders (the scene read
+/// over a shutter keeps its cameras in file order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraPick {
+    /// The scene's camera of this index.
+    Index(usize),
+    /// A default camera framing the scene from a three-quarter view.
+    Framing,
+}
+
+impl CameraPick {
+    /// The camera `wanted` names (by index, name or node name), else the first one, else a
+    /// framing camera.
+    pub fn choose(scene: &Scene, wanted: Option<&str>) -> Result<CameraPick> {
+        let Some(spec) = wanted else {
+            return Ok(if scene.cameras.is_empty() {
+                CameraPick::Framing
+            } else {
+                CameraPick::Index(0)
+            });
+        };
+        if let Ok(index) = spec.parse::<usize>() {
+            return match scene.cameras.get(index) {
+                Some(_) => Ok(CameraPick::Index(index)),
+                None => Err(anyhow!("no camera {index}; {}", camera_list(scene))),
+            };
+        }
+        scene
+            .cameras
+            .iter()
+            .position(|c| c.name == spec || c.source.ends_with(&format!("'{spec}'")))
+            .map(CameraPick::Index)
+            .ok_or_else(|| anyhow!("no camera named '{spec}'; {}", camera_list(scene)))
+    }
+
+    /// The camera in `scene`; a framing camera fits the image's aspect when both sides are
+    /// given.
+    pub fn camera(self, scene: &Scene, width: Option<u32>, height: Option<u32>) -> Result<Camera> {
+        match self {
+            CameraPick::Index(index) => scene
+                .cameras
+                .get(index)
+                .cloned()
+                .ok_or_else(|| anyhow!("no camera {index}; {}", camera_list(scene))),
+            CameraPick::Framing => {
+                let aspect = match (width, height) {
+                    (Some(w), Some(h)) => w as f32 / h as f32,
+                    _ => 1.0,
+                };
+                Ok(Camera::framing(&scene.bounds(), aspect))
+            }
+        }
+    }
+}
+
+/// The scene's cameras, for an error naming one that is not there.
+fn camera_list(scene: &Scene) -> String {
+    if scene.cameras.is_empty() {
+        return "the scene has no cameras".to_string();
+    }
+    let names: Vec<String> = scene
+        .cameras
+        .iter()
+        .enumerate()
+        .map(|(i, c)| format!("{i} '{}' ({})", c.name, c.source))
+        .collect();
+    format!("cameras: {}", names.join(", "))
+}
+
 /// The camera asked for, the first one, or one that frames the scene.
 pub fn choose_camera(
     scene: &Scene,
@@ -69,47 +139,7 @@ pub fn choose_camera(
     width: Option<u32>,
     height: Option<u32>,
 ) -> Result<Camera> {
-    let list = || {
-        if scene.cameras.is_empty() {
-            "the scene has no cameras".to_string()
-        } else {
-            let names: Vec<String> = scene
-                .cameras
-                .iter()
-                .enumerate()
-                .map(|(i, c)| format!("{i} '{}' ({})", c.name, c.source))
-                .collect();
-            format!("cameras: {}", names.join(", "))
-        }
-    };
-    match wanted {
-        Some(spec) => {
-            if let Ok(index) = spec.parse::<usize>() {
-                return scene
-                    .cameras
-                    .get(index)
-                    .cloned()
-                    .ok_or_else(|| anyhow!("no camera {index}; {}", list()));
-            }
-            let found = scene
-                .cameras
-                .iter()
-                .find(|c| c.name == spec || c.source.ends_with(&format!("'{spec}'")));
-            found
-                .cloned()
-                .ok_or_else(|| anyhow!("no camera named '{spec}'; {}", list()))
-        }
-        None => Ok(match scene.cameras.first() {
-            Some(c) => c.clone(),
-            None => {
-                let aspect = match (width, height) {
-                    (Some(w), Some(h)) => w as f32 / h as f32,
-                    _ => 1.0,
-                };
-                Camera::framing(&scene.bounds(), aspect)
-            }
-        }),
-    }
+    CameraPick::choose(scene, wanted)?.camera(scene, width, height)
 }
 
 /// Image size from the options, filling a missing side from the camera's aspect ratio.

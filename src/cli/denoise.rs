@@ -5,11 +5,10 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 
 use super::args::DenoiseArgs;
-use super::signals::{Phase, output_lock, set_phase};
+use super::signals::{Phase, check_output, write_output};
 use crate::denoise::denoise;
 use crate::limits::{check_memory, set_memory_budget};
 use crate::merge::read_part;
-use crate::output::{check_writable, write_image_with_record};
 use crate::render::Image;
 
 /// Denoises `image` for writing, saying what guides it unless `quiet`.
@@ -42,10 +41,7 @@ pub fn denoise_for_output(image: &mut Image, threads: Option<u32>, quiet: bool) 
 /// and writes the result with its record.
 pub fn run_denoise(args: &DenoiseArgs) -> Result<()> {
     set_memory_budget(args.max_memory.unwrap_or(0));
-    {
-        let _writing = output_lock();
-        check_writable(&args.output)?;
-    }
+    check_output(&args.output)?;
     let part = read_part(&args.input)?;
     let (width, height) = (part.record.identity.width, part.record.identity.height);
     // The part's channels (at most 32 f32) and the image made of them.
@@ -59,9 +55,13 @@ pub fn run_denoise(args: &DenoiseArgs) -> Result<()> {
     denoise_for_output(&mut image, args.threads, args.quiet)?;
     let mut record = part.record;
     record.denoised = true;
-    let _writing = output_lock();
-    write_image_with_record(&args.output, &image, Some(&record), args.view_transform)?;
-    set_phase(Phase::Finished);
+    write_output(
+        &args.output,
+        &image,
+        Some(&record),
+        args.view_transform.into(),
+        Some(Phase::Finished),
+    )?;
     if !args.quiet {
         eprintln!("wrote {}", args.output.display());
     }

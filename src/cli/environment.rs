@@ -7,89 +7,69 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use glam::{Mat3, Vec3};
 
-use super::args::{Args, parse_number};
+use super::args::EnvironmentArgs;
+use super::values::EnvironmentChoice;
 use crate::load::load_environment;
 use crate::record::sha256_file;
 use crate::scene::{Environment, Scene};
 
-/// What `--environment` asked for.
+/// Where the environment that lights the render came from.
 #[derive(Clone, Debug, PartialEq)]
-pub enum EnvironmentChoice {
-    /// No environment at all: black.
+pub enum EnvironmentSource {
+    /// `--environment none`: black.
     None,
-    /// Constant radiance.
+    /// `--environment R,G,B`.
     Constant(Vec3),
-    /// A latitude–longitude image file.
-    File(PathBuf),
+    /// `--environment FILE`, with the file's SHA-256.
+    File {
+        /// The file as named.
+        path: PathBuf,
+        /// Its SHA-256: a map replaced between parts stops their merge.
+        sha256: String,
+    },
+    /// The default studio light, for a scene with no light at all.
+    Studio,
+    /// The scene's own (or none, if it has none).
+    Scene,
 }
 
-/// Parses `none`, one number, `R,G,B`, or anything else as a file name.
-pub fn parse_environment(text: &str) -> Result<EnvironmentChoice, String> {
-    if text.eq_ignore_ascii_case("none") {
-        return Ok(EnvironmentChoice::None);
-    }
-    let numbers: Option<Vec<f32>> = text.split(',').map(|p| p.trim().parse().ok()).collect();
-    match numbers.as_deref() {
-        Some(&[v]) => colour(Vec3::splat(v), text),
-        Some(&[r, g, b]) => colour(Vec3::new(r, g, b), text),
-        Some(_) => Err(format!("'{text}' is neither one number, R,G,B nor a file")),
-        None => Ok(EnvironmentChoice::File(PathBuf::from(text))),
-    }
+/// The environment a render uses: where it came from and what the options did to it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvironmentSetting {
+    /// Where it came from.
+    pub source: EnvironmentSource,
+    /// `--environment-strength`.
+    pub strength: f32,
+    /// `--environment-rotation`, in degrees.
+    pub rotation: f32,
+    /// `--hide-environment`.
+    pub hidden: bool,
 }
 
-fn colour(c: Vec3, text: &str) -> Result<EnvironmentChoice, String> {
-    if c.is_finite() && c.min_element() >= 0.0 {
-        Ok(EnvironmentChoice::Constant(c))
-    } else {
-        Err(format!(
-            "'{text}': radiance must be finite and not negative"
-        ))
-    }
-}
-
-/// A finite, non-negative strength.
-pub fn parse_strength(text: &str) -> Result<f32, String> {
-    let ok = |s: f32| s.is_finite() && s >= 0.0;
-    parse_number(text, ok, "a finite, non-negative number")
-}
-
-/// A finite angle in degrees.
-pub fn parse_degrees(text: &str) -> Result<f32, String> {
-    parse_number(text, f32::is_finite, "a finite number of degrees")
-}
-
-/// Sets the scene's environment as the options say. Returns the note to print when the
-/// default studio light was chosen, and the label the render record keeps.
-pub fn apply_environment(
-    scene: &mut Scene,
-    args: &Args,
-    scene_path: &Path,
-) -> Result<(Option<String>, String)> {
-    let mut note = None;
-    let mut label = match &args.environment {
+/// Sets the scene's environment as the options say, and says what it became.
+pub fn apply_environment(scene: &mut Scene, args: &EnvironmentArgs) -> Result<EnvironmentSetting> {
+    let source = match &args.environment {
         Some(EnvironmentChoice::None) => {
             scene.environment = None;
-            "none".to_string()
+            EnvironmentSource::None
         }
         Some(EnvironmentChoice::Constant(c)) => {
             scene.environment = Some(Environment::constant(*c, "--environment"));
-            format!("{},{},{}", c.x, c.y, c.z)
+            EnvironmentSource::Constant(*c)
         }
         Some(EnvironmentChoice::File(path)) => {
             scene.environment = Some(load_environment(path)?);
-            let sha = sha256_file(path).with_context(|| format!("{}", path.display()))?;
-            format!("{} sha256={sha}", path.display())
+            let sha256 = sha256_file(path).with_context(|| format!("{}", path.display()))?;
+            EnvironmentSource::File {
+                path: path.clone(),
+                sha256,
+            }
         }
         None if !scene.has_emitters() && scene.instanced_triangle_count() > 0 => {
             scene.environment = Some(Environment::studio());
-            note = Some(format!(
-                "note: {}: the scene has no lights; lighting it with the default studio environment \
-                 (--environment FILE.hdr or R,G,B for your own, --environment none for black)",
-                scene_path.display()
-            ));
-            "studio".to_string()
+            EnvironmentSource::Studio
         }
-        None => "scene".to_string(),
+        None => EnvironmentSource::Scene,
     };
     // Without an environment, escaping camera rays are black with alpha 0 already.
     if let Some(e) = &mut scene.environment {
@@ -100,36 +80,19 @@ pub fn apply_environment(
             e.camera_visible = false;
         }
     }
-    label = format!(
-        "environment={label} strength={} rotation={}{}",
-        args.environment_strength,
-        args.environment_rotation,
-        if args.hide_environment { " hidden" } else { "" }
-    );
-    Ok((note, label))
+    Ok(EnvironmentSetting {
+        source,
+        strength: args.environment_strength,
+        rotation: args.environment_rotation,
+        hidden: args.hide_environment,
+    })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn environment_option_reads_none_colours_and_files() {
-        assert_eq!(parse_environment("none"), Ok(EnvironmentChoice::None));
-        assert_eq!(
-            parse_environment("0.5"),
-            Ok(EnvironmentChoice::Constant(Vec3::splat(0.5)))
-        );
-        assert_eq!(
-            parse_environment("0.1, 0.2,0.3"),
-            Ok(EnvironmentChoice::Constant(Vec3::new(0.1, 0.2, 0.3)))
-        );
-        assert_eq!(
-            parse_environment("sky.hdr"),
-            Ok(EnvironmentChoice::File("sky.hdr".into()))
-        );
-        assert!(parse_environment("1,2").is_err());
-        assert!(parse_environment("-1,0,0").is_err());
-        assert!(parse_environment("nan").is_err());
-    }
+/// The note that says the default studio light was chosen, and how to choose another.
+pub fn studio_note(scene_path: &Path) -> String {
+    format!(
+        "note: {}: the scene has no lights; lighting it with the default studio environment \
+         (--environment FILE.hdr or R,G,B for your own, --environment none for black)",
+        scene_path.display()
+    )
 }

@@ -6,11 +6,10 @@ use anyhow::Result;
 
 use super::args::MergeArgs;
 use super::denoise::denoise_for_output;
-use super::signals::{Phase, output_lock, set_phase};
+use super::signals::{Phase, check_output, write_output};
 use crate::denoise::check_available;
 use crate::limits::set_memory_budget;
 use crate::merge::merge_files;
-use crate::output::{check_writable, write_image_with_record};
 use crate::record::format_range;
 
 /// Reads, checks and merges the parts, and writes the merged image.
@@ -19,10 +18,7 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
     if args.denoise {
         check_available()?;
     }
-    {
-        let _writing = output_lock();
-        check_writable(&args.output)?;
-    }
+    check_output(&args.output)?;
     let start = Instant::now();
     let (mut image, mut record) = merge_files(&args.parts, args.samples.clone())?;
     if record.nonfinite > 0 {
@@ -35,11 +31,13 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
         denoise_for_output(&mut image, args.threads, args.quiet)?;
         record.denoised = true;
     }
-    {
-        let _writing = output_lock();
-        write_image_with_record(&args.output, &image, Some(&record), args.view_transform)?;
-        set_phase(Phase::Finished);
-    }
+    write_output(
+        &args.output,
+        &image,
+        Some(&record),
+        args.view_transform.into(),
+        Some(Phase::Finished),
+    )?;
     if !args.quiet {
         eprintln!(
             "merged {} part(s) of {} ({}x{}, camera {}): samples {} in {:.2} s; wrote {}",

@@ -5,15 +5,19 @@
 
 mod args;
 mod camera;
+mod choices;
 mod denoise;
 mod environment;
+mod identity;
+mod inspect;
 mod merge;
 mod motion;
 mod render;
 pub mod signals;
+mod values;
 
 pub use args::{Args, Command, DenoiseArgs, MergeArgs};
-pub use camera::{choose_camera, image_size, with_depth_of_field};
+pub use camera::{CameraPick, choose_camera, image_size, with_depth_of_field};
 
 use std::sync::atomic::AtomicBool;
 

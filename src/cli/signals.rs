@@ -12,6 +12,10 @@ use std::time::Duration;
 
 use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
 
+use crate::output::{OutputError, ViewTransform, check_writable, write_image_with_record};
+use crate::record::RenderRecord;
+use crate::render::Image;
+
 /// Set by the first signal during a render: finish the pass, write, exit.
 pub static STOP: AtomicBool = AtomicBool::new(false);
 
@@ -46,6 +50,31 @@ pub fn output_lock() -> MutexGuard<'static, ()> {
     OUTPUT
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Checks that `path` can take the output, holding the output lock (the check creates and
+/// removes a probe file, which a signal must not strand).
+pub fn check_output(path: &Path) -> Result<(), OutputError> {
+    let _writing = output_lock();
+    check_writable(path)
+}
+
+/// Writes an output under the output lock, so no signal ends the process half-way through;
+/// `then` is the phase entered before the lock is let go (the last write of a run enters
+/// [`Phase::Finished`], after which a signal quits at once).
+pub fn write_output(
+    path: &Path,
+    image: &Image,
+    record: Option<&RenderRecord>,
+    view: ViewTransform,
+    then: Option<Phase>,
+) -> Result<(), OutputError> {
+    let _writing = output_lock();
+    write_image_with_record(path, image, record, view)?;
+    if let Some(phase) = then {
+        set_phase(phase);
+    }
+    Ok(())
 }
 
 /// The exit code for a run that a signal stopped: 128 + its number (130 for SIGINT, 143 for

@@ -76,7 +76,7 @@ impl LoadOptions {
 /// three ("Lighting Mode"); each is converted to radiant intensity (W/sr) for point and spot
 /// lights and irradiance (W/m²) for directional lights, which is what Blender's own watts
 /// mean to Cycles, so exported lights keep their balance with emissive surfaces.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GltfLightUnits {
     /// The glTF specification: candela and lux, at 683 lm/W (Blender's "Standard").
     #[default]
@@ -85,6 +85,17 @@ pub enum GltfLightUnits {
     Unitless,
     /// Blender's "Raw": point and spot lights in watts of emitted power, directional in W/m².
     Raw,
+}
+
+impl GltfLightUnits {
+    /// The name on the command line and in render records.
+    pub fn name(self) -> &'static str {
+        match self {
+            GltfLightUnits::Standard => "standard",
+            GltfLightUnits::Unitless => "unitless",
+            GltfLightUnits::Raw => "raw",
+        }
+    }
 }
 
 /// Loads a scene with default options; see [`load_scene_with`].

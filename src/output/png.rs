@@ -8,7 +8,7 @@ use crate::render::Image;
 use crate::scene::linear_to_srgb;
 
 /// How a PNG turns linear Rec.709 radiance into display values (EXR stays linear).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ViewTransform {
     /// The sRGB transfer curve alone: values above 1 clip.
     #[default]

@@ -12,7 +12,7 @@
 use glam::Vec2;
 
 /// Which filter, by name on the command line.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FilterKind {
     /// Uniform over a square `width` pixels wide (1: the pixel itself).
     #[default]
@@ -22,6 +22,26 @@ pub enum FilterKind {
     /// The 4-term Blackman–Harris window (Harris 1978) spanning ±width pixels: Cycles'
     /// definition, whose default "1.5 px" spans three pixels.
     BlackmanHarris,
+}
+
+impl FilterKind {
+    /// The name on the command line and in render records.
+    pub fn name(self) -> &'static str {
+        match self {
+            FilterKind::Box => "box",
+            FilterKind::Gaussian => "gaussian",
+            FilterKind::BlackmanHarris => "blackman-harris",
+        }
+    }
+
+    /// The width a filter has unless told otherwise: the pixel for a box, Cycles' 1.5 px
+    /// for the others.
+    pub fn default_width(self) -> f32 {
+        match self {
+            FilterKind::Box => 1.0,
+            _ => 1.5,
+        }
+    }
 }
 
 /// Steps of the tabulated CDF.

@@ -37,6 +37,12 @@ use sampler::Sampler;
 use sampling::mix64;
 use surface::InstanceFrame;
 
+/// Samples per pixel when nothing says how many.
+pub const DEFAULT_SPP: u32 = 64;
+
+/// Most bounces along a path when nothing says how many.
+pub const DEFAULT_MAX_DEPTH: u32 = 16;
+
 /// What to render and how.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -72,8 +78,8 @@ impl Default for RenderSettings {
         RenderSettings {
             width: 512,
             height: 512,
-            samples: 0..64,
-            max_depth: 16,
+            samples: 0..DEFAULT_SPP,
+            max_depth: DEFAULT_MAX_DEPTH,
             seed: 0,
             strategy: Strategy::Mis,
             filter: FilterKind::Box,

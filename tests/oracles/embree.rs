@@ -127,8 +127,8 @@ impl Embree {
     /// one 16-byte vector; written a field at a time (as [`Embree::rtc_ray`] alone writes
     /// them), such a load spans four stores still in flight, cannot take its data from them
     /// and waits until they reach the cache (a failed store-to-load forward): 16–19 ns of
-    /// each query on the dragons, 8–19 % of Embree's time (docs/grid.md, thirtieth
-    /// session). The grid reads the benchmark's rays from memory, so this keeps the
+    /// each query on the dragons, 8–19 % of Embree's time (measured at
+    /// f44f9f7). The grid reads the benchmark's rays from memory, so this keeps the
     /// comparison level. Called just before the query, so these are the last stores to
     /// those bytes.
     #[inline(always)]

@@ -15,7 +15,7 @@ clamping, no denoising, 64 bounces, black world).
   a wall that keep every Principled default (roughness 0.5, a 4 % specular layer).
 - principled_plastics: glossy (0.1) and rough (0.6) plastics and a clear-coated sphere.
   (Sheen is not compared: Cycles' Principled sheen is its "microfiber" model, glTF's
-  KHR_materials_sheen is Charlie's, which gridtrace follows; see the README.)
+  KHR_materials_sheen is Charlie's, which gridtrace follows; see docs/manual/materials.md.)
 - principled_textured: a metal panel whose roughness comes from a texture and whose normal from
   a normal map.
 - principled_glass: a rough glass ball (0.2). Blender's USD exporter writes no transmission

@@ -47,7 +47,7 @@ done
 # median and range, and each process's speed ($2 and $3 head the columns).
 report() {
   # Embree's speed per process tells how fast memory was in it (the grid's ratio is lower
-  # where memory is fast: docs/grid.md, "Where the grid stands").
+  # where memory is fast: docs/benchmarks.md).
   echo "| model | set | $2 | median | range | $3 |"
   echo "|---|---|---|---|---|---|"
   awk '{ key = $2 " " $3; if (!(key in seen)) { seen[key] = 1; order[++n] = key }

@@ -10,7 +10,7 @@
 #
 # The simulated caches are this machine's per core: 32 KiB of L1 data (8-way), and as the
 # last level the 2 MiB L2 (16-way) — the L3 is shared with other machines and holds little
-# of a process's data (docs/grid.md, "pointer chase"). COUNTERS_RAYS rays per set (default
+# of a process's data (docs/design/grid.md, "The walk"). COUNTERS_RAYS rays per set (default
 # 10,000), traced once unseen and once counted. Prints a table per structure and set, then
 # the grid's counts by the source file the code was inlined from. About two minutes per
 # structure and set on the full dragon; two run at once. COUNTERS_REPORT_ONLY=1 prints the

@@ -30,7 +30,7 @@
 //! of its time in cache. Each grid's walk is compiled with or without the test
 //! (`BOXED`), and grids whose blocks fit in the caches keep no boxes ([`BOXED_BLOCKS`]):
 //! there a block costs no more than the test, and the 11k dragon lost 1–12 % with boxes
-//! (docs/grid.md, twenty-sixth session).
+//! (measured at b0114e4; docs/design/grid.md).
 //!
 //! Grids whose blocks outgrow even the last-level cache ([`MASKED_BLOCKS_FROM`]) keep each
 //! block's word too, and order the triangles of each cell of several blocks so that a
@@ -74,7 +74,7 @@ const NOTHING: u32 = 0x7fff;
 /// blocks gain (outside rays 0.94 the time, bounce 0.93, shadow 0.97, camera and light
 /// 1.04; in cache 1.03 / 1.09 / 1.07 / 1.00 / 1.00), while the 203k dragon's 23 MB lost
 /// 1–10 % (in cache 7–11 %): where the blocks stay in the caches, the masks cost more than
-/// the blocks they spare (docs/grid.md, thirty-first session).
+/// the blocks they spare (measured at 6d13fe3).
 pub(super) const MASKED_BLOCKS_FROM: usize = 48 << 20;
 
 /// Which boxes a grid whose blocks take `block_bytes` keeps.
@@ -335,7 +335,7 @@ pub(super) fn meets<const FUSED: bool>(walk: &CellWalk<FUSED>, word: u32, margin
 /// range's `i`-th block. Only the first [`MASKED_BLOCKS`] blocks have bits; the walk tests
 /// any beyond them. One box at a time: eight at once in vector lanes, with the words
 /// decoded lane by lane, took 1.04–1.06 the time of this on the full dragon's outside,
-/// bounce and light rays (docs/grid.md, thirty-first session).
+/// bounce and light rays (measured at 6d13fe3).
 #[inline(always)]
 pub(super) fn block_mask<const FUSED: bool>(
     walk: &CellWalk<FUSED>,

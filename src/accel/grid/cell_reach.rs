@@ -16,8 +16,8 @@
 //! which stay in the caches beside the blocks. Its cubes are coarser (a cell in a unit
 //! that holds an occupied cell is left by a plain step): on the full dragon 0.94–0.95 the
 //! time of outside, bounce and shadow rays, 1.04 of camera rays (whose reaches are in
-//! cache), and on the 11k dragon, which is all in cache, 1.03–1.06 (docs/grid.md,
-//! twenty-fifth session).
+//! cache), and on the 11k dragon, which is all in cache, 1.03–1.06 (measured at
+//! ed4cc45; docs/design/grid.md).
 //!
 //! Computed per macrocell and octant on rows of bits over the macrocell and its neighbours
 //! towards the octant: the cells whose cube of side k + 1 is empty are those whose cubes of

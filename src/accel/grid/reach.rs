@@ -17,7 +17,7 @@
 //! stays empty: where a cube stops at the first occupied cell in any direction ahead, the
 //! box goes on along the axes that are still clear, so a ray leaving it by those axes' far
 //! faces leaps further (outside rays that miss the full dragon take 2.8 leaps over empty
-//! macrocells instead of 3.9; docs/grid.md, twenty-fourth session). Each side is at most
+//! macrocells instead of 3.9; measured at 624bb22). Each side is at most
 //! [`MAX_SIDE`] cells, so the three fit in a byte each ([`CellIndex`]); found by bisection,
 //! each box's occupied cells counted from a table of sums ([`BoxCounts`]).
 //!

@@ -1,4 +1,4 @@
-//! glTF materials and their textures, as scene materials (the README's table).
+//! glTF materials and their textures, as scene materials (docs/manual/materials.md's table).
 
 use glam::{Affine2, Vec2, Vec3, Vec4};
 
@@ -13,7 +13,7 @@ use crate::scene::{
 impl GltfLoader {
     /// A glTF material as the one PBR description: `pbrMetallicRoughness`, emission with
     /// `KHR_materials_emissive_strength`, and the `KHR_materials_{ior, specular,
-    /// transmission, clearcoat, sheen, volume}` extensions (the README's table).
+    /// transmission, clearcoat, sheen, volume}` extensions (docs/manual/materials.md's table).
     pub(super) fn convert_material(
         &mut self,
         document: &gltf::Document,
