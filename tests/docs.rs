@@ -46,7 +46,10 @@ fn every_option_is_in_the_command_line_page() {
     let mut missing = Vec::new();
     for command in [&[][..], &["merge"], &["denoise"]] {
         let options = options_listed(command);
-        assert!(options.len() >= 4, "too few options found for {command:?}: {options:?}");
+        assert!(
+            options.len() >= 4,
+            "too few options found for {command:?}: {options:?}"
+        );
         for option in options {
             if !page.contains(&format!("`{option}")) {
                 missing.push(format!("{} {option}", command.join(" ")));
@@ -156,13 +159,17 @@ fn every_relative_link_resolves() {
             }
         }
     }
-    assert!(checked > 50, "only {checked} links found: is the parser right?");
+    assert!(
+        checked > 50,
+        "only {checked} links found: is the parser right?"
+    );
     assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
 }
 
 #[test]
 fn the_link_checker_finds_links_and_anchors() {
-    let text = "See [a](x.md#one-two) and `[not](a link)`.\n```\n[no](code.md)\n```\n<img src=\"p.png\">";
+    let text =
+        "See [a](x.md#one-two) and `[not](a link)`.\n```\n[no](code.md)\n```\n<img src=\"p.png\">";
     assert_eq!(link_targets(text), vec!["x.md#one-two", "p.png"]);
     assert_eq!(anchor_of(" One, two: (three)"), "one-two-three");
     assert!(anchors("# Title\n## Layers, denoising\n").contains("layers-denoising"));
@@ -175,7 +182,13 @@ fn project_texts() -> Vec<PathBuf> {
         .iter()
         .map(|f| repo().join(f))
         .collect();
-    let skipped = ["node_modules", "target", "fuzz_crashes", "fuzz_hangs", "corpus"];
+    let skipped = [
+        "node_modules",
+        "target",
+        "fuzz_crashes",
+        "fuzz_hangs",
+        "corpus",
+    ];
     let kinds = ["rs", "md", "sh", "py", "mjs", "toml", "json", "sbatch"];
     while let Some(folder) = folders.pop() {
         let Ok(entries) = fs::read_dir(&folder) else {
@@ -205,8 +218,22 @@ fn project_texts() -> Vec<PathBuf> {
 #[test]
 fn no_text_tells_the_projects_history() {
     let ordinals = [
-        "first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth",
-        "tenth", "eleventh", "twelfth", "teenth", "twentieth", "thirtieth", "fortieth",
+        "first",
+        "second",
+        "third",
+        "fourth",
+        "fifth",
+        "sixth",
+        "seventh",
+        "eighth",
+        "ninth",
+        "tenth",
+        "eleventh",
+        "twelfth",
+        "teenth",
+        "twentieth",
+        "thirtieth",
+        "fortieth",
     ];
     let period = ["sess", "ion"].concat();
     let issue = ["iss", "ue "].concat();
@@ -224,7 +251,8 @@ fn no_text_tells_the_projects_history() {
             let names_a_period = words.windows(2).any(|pair| {
                 pair[1].starts_with(&period)
                     && (ordinals.iter().any(|o| pair[0].ends_with(o))
-                        || pair[0].ends_with("th") && pair[0].starts_with(|c: char| c.is_ascii_digit()))
+                        || pair[0].ends_with("th")
+                            && pair[0].starts_with(|c: char| c.is_ascii_digit()))
             });
             let names_an_issue = lower.match_indices(&issue).any(|(i, _)| {
                 lower[i + issue.len()..]
@@ -232,9 +260,18 @@ fn no_text_tells_the_projects_history() {
                     .starts_with(|c: char| c.is_ascii_digit())
             });
             if names_a_period || names_an_issue {
-                found.push(format!("{}:{}: {}", file.display(), number + 1, line.trim()));
+                found.push(format!(
+                    "{}:{}: {}",
+                    file.display(),
+                    number + 1,
+                    line.trim()
+                ));
             }
         }
     }
-    assert!(found.is_empty(), "history in the repository's text:\n{}", found.join("\n"));
+    assert!(
+        found.is_empty(),
+        "history in the repository's text:\n{}",
+        found.join("\n")
+    );
 }

@@ -2,13 +2,10 @@
 //! and a top level over the instances (a list, or a grid of their own when there are many).
 
 mod box_lanes;
-mod cell_lanes;
 mod cpu;
-mod frame;
 pub mod grid;
 mod huge_pages;
 mod instances;
-mod prefetch;
 mod ray;
 mod top_level;
 mod triangle;

@@ -75,10 +75,7 @@ fn load_label(options: &LoadOptions) -> String {
 /// motion blur.
 fn shutter_label(shutter: Option<Shutter>) -> String {
     shutter.map_or_else(String::new, |s| {
-        format!(
-            " shutter={}..{} motion-steps={}",
-            s.open, s.close, s.steps
-        )
+        format!(" shutter={}..{} motion-steps={}", s.open, s.close, s.steps)
     })
 }
 
@@ -157,7 +154,10 @@ mod tests {
             filter_width: 1.5,
             ..RenderSettings::default()
         };
-        let camera = Camera::framing(&crate::scene::Aabb::from_points([Vec3::ZERO, Vec3::ONE]), 1.0);
+        let camera = Camera::framing(
+            &crate::scene::Aabb::from_points([Vec3::ZERO, Vec3::ONE]),
+            1.0,
+        );
         let identity = render_identity(inputs, &camera, &settings);
         assert_eq!(
             identity.options,

@@ -5,7 +5,7 @@ use std::fmt::Write;
 
 use glam::Vec3;
 
-use crate::render::Bsdf;
+use crate::render::{Bsdf, EmissiveTriangles};
 use crate::scene::{AlphaMode, LightKind, Material, Projection, Scene};
 
 /// The report: meshes, instances, materials with their class, textures, lights with their
@@ -29,7 +29,7 @@ pub fn describe(scene: &Scene, warnings: &[String]) -> String {
             vector(bounds.max)
         );
     }
-    let emitted = emitted_power(scene);
+    let emitted = EmissiveTriangles::collect(scene).power_by_material(scene);
     let _ = writeln!(out, "materials: {}", scene.materials.len());
     for (i, m) in scene.materials.iter().enumerate() {
         let _ = writeln!(
@@ -190,33 +190,6 @@ fn material_summary(m: &Material, emitted: f32) -> String {
         let _ = write!(s, "; absorption {} per unit", vector(m.absorption));
     }
     s
-}
-
-/// Power (W, mean over channels) each material emits over all its instances, with constant
-/// emission (textures not counted).
-fn emitted_power(scene: &Scene) -> Vec<f32> {
-    let mut power = vec![0.0f32; scene.materials.len()];
-    for inst in &scene.instances {
-        let mesh = &scene.meshes[inst.mesh];
-        let material = &scene.materials[mesh.material];
-        if !material.is_emissive() {
-            continue;
-        }
-        let area: f32 = mesh
-            .indices
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| {
-                    inst.world_from_object
-                        .transform_point3(mesh.positions[i as usize])
-                });
-                0.5 * (b - a).cross(c - a).length()
-            })
-            .filter(|a| a.is_finite())
-            .sum();
-        power[mesh.material] += area * material.exitance();
-    }
-    power
 }
 
 fn light_summary(kind: &LightKind) -> String {

@@ -22,7 +22,7 @@ pub use camera::RayGenerator;
 pub use film::{Film, Image, PixelAccumulator};
 pub use filter::{FilterKind, PixelFilter, profile as filter_profile};
 pub use integrator::{PathResult, Strategy};
-pub use lights::{LightSample, LightSet};
+pub use lights::{EmissiveTriangles, LightSample, LightSet};
 pub use surface::{gamma, interpolate_with_error, offset_ray_origin, transform_point_with_error};
 
 use std::ops::Range;

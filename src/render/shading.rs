@@ -27,20 +27,11 @@ pub struct Shading {
     pub coat_normal: Option<Vec3>,
 }
 
-/// Texture coordinates of set `set` at vertex `vertex`; zero if the mesh has none.
-pub fn vertex_uv(mesh: &Mesh, set: usize, vertex: usize) -> Vec2 {
-    mesh.uvs
-        .get(set)
-        .and_then(|uvs| uvs.get(vertex))
-        .copied()
-        .unwrap_or(Vec2::ZERO)
-}
-
 /// Texture coordinates of set `set` at the surface point; zero if the mesh has none.
 pub fn uv_at(mesh: &Mesh, set: usize, vertices: [usize; 3], barycentrics: Vec3) -> Vec2 {
-    barycentrics.x * vertex_uv(mesh, set, vertices[0])
-        + barycentrics.y * vertex_uv(mesh, set, vertices[1])
-        + barycentrics.z * vertex_uv(mesh, set, vertices[2])
+    barycentrics.x * mesh.uv(set, vertices[0])
+        + barycentrics.y * mesh.uv(set, vertices[1])
+        + barycentrics.z * mesh.uv(set, vertices[2])
 }
 
 /// `reference` looked up at the surface point.

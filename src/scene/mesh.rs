@@ -28,6 +28,15 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// Texture coordinates of set `set` at vertex `vertex`; zero if the mesh has none.
+    pub fn uv(&self, set: usize, vertex: usize) -> Vec2 {
+        self.uvs
+            .get(set)
+            .and_then(|uvs| uvs.get(vertex))
+            .copied()
+            .unwrap_or(Vec2::ZERO)
+    }
+
     /// Bounds of the finite vertices (a NaN or infinite corner's triangles are never hit, and
     /// must not throw the default camera to infinity).
     pub fn bounds(&self) -> Aabb {

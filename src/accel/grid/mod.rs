@@ -14,30 +14,20 @@
 //! the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if it lies within the
 //! current cell.
 
-mod block;
-mod block_order;
-mod box_counts;
-mod build;
-mod cell_box;
-mod cell_order;
-mod cell_reach;
-mod cells;
-pub mod density;
-mod mesh_triangles;
-mod occupied;
-mod overlap;
-mod reach;
-mod traverse;
+pub mod build;
+mod storage;
+pub(crate) mod walk;
 
-pub use traverse::{TraversalCounts, TraversalStats};
+pub use build::density;
+pub use walk::{TraversalCounts, TraversalStats};
 
 use glam::{UVec3, Vec3};
 
-use block::Block;
-use cells::{CellIndex, Lookup};
-
-use super::frame::GridFrame;
 use crate::scene::Aabb;
+use storage::block::{self, Block};
+use storage::cell_box;
+use storage::cells::{CellIndex, Lookup};
+use walk::frame::GridFrame;
 
 /// A uniform grid accelerating ray queries against one triangle list.
 #[derive(Clone, Debug)]

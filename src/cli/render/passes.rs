@@ -67,7 +67,11 @@ struct Checkpointer<'a> {
 }
 
 impl Checkpointer<'_> {
-    fn maybe_write(&mut self, recorder: &Recorder, image_so_far: &dyn Fn() -> (Image, RenderStats)) {
+    fn maybe_write(
+        &mut self,
+        recorder: &Recorder,
+        image_so_far: &dyn Fn() -> (Image, RenderStats),
+    ) {
         let Some(every) = self.every else { return };
         if self.last.elapsed() < every || self.error.is_some() {
             return;
@@ -110,11 +114,16 @@ pub fn render_passes(
         args.image.quiet || args.sampling.time_limit.is_some(),
     );
     let mut display = args.image.display.as_deref().map(|address| {
-        LiveView::connect(address, &recorder.scene_name, settings.width, settings.height)
-            .unwrap_or_else(|e| {
-                eprintln!("warning: --display {address}: {e}; rendering without a live view");
-                LiveView::disconnected()
-            })
+        LiveView::connect(
+            address,
+            &recorder.scene_name,
+            settings.width,
+            settings.height,
+        )
+        .unwrap_or_else(|e| {
+            eprintln!("warning: --display {address}: {e}; rendering without a live view");
+            LiveView::disconnected()
+        })
     });
     let mut checkpoints = Checkpointer {
         every: args.image.checkpoint.map(Duration::from_secs_f64),

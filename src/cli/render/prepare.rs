@@ -76,8 +76,13 @@ pub fn prepare(args: &Args, plan: &Plan) -> Result<Prepared> {
             .and_then(|camera| camera.shutter),
         Err(_) => None,
     };
-    let (loaded, shutter) =
-        apply_shutter(loaded, &args.motion, camera_shutter, scene_path, load_options)?;
+    let (loaded, shutter) = apply_shutter(
+        loaded,
+        &args.motion,
+        camera_shutter,
+        scene_path,
+        load_options,
+    )?;
     let dependencies_sha256 = sha256_files(folder_of(scene_path), &loaded.files)
         .context("hashing the files the scene reads")?;
     for warning in &loaded.warnings {
@@ -134,7 +139,12 @@ fn check_contents(
 
 /// The camera with its lens, checked, and the settings of an image of the size the
 /// options and the camera's aspect ratio give, checked against the limits.
-fn frame(args: &Args, plan: &Plan, scene: &Scene, camera: Camera) -> Result<(Camera, RenderSettings)> {
+fn frame(
+    args: &Args,
+    plan: &Plan,
+    scene: &Scene,
+    camera: Camera,
+) -> Result<(Camera, RenderSettings)> {
     let view = &args.view;
     let camera = with_depth_of_field(camera, view.fstop, view.focus_distance, scene);
     camera.validate().map_err(|why| {

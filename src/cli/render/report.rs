@@ -37,7 +37,12 @@ pub fn prepared(plan: &Plan, prepared: &Prepared, renderer: &Renderer, took: Dur
 }
 
 /// Says how the render ended, denoises if asked, writes the output and the summary.
-pub fn finish(args: &Args, plan: &Plan, prepared: &Prepared, rendered: Rendered) -> Result<Outcome> {
+pub fn finish(
+    args: &Args,
+    plan: &Plan,
+    prepared: &Prepared,
+    rendered: Rendered,
+) -> Result<Outcome> {
     let Rendered {
         mut image,
         stats,
@@ -60,7 +65,13 @@ pub fn finish(args: &Args, plan: &Plan, prepared: &Prepared, rendered: Rendered)
     }
     let record = recorder.record(&image, &stats);
     let view = args.image.view_transform.into();
-    write_output(&plan.output, &image, Some(&record), view, Some(Phase::Finished))?;
+    write_output(
+        &plan.output,
+        &image,
+        Some(&record),
+        view,
+        Some(Phase::Finished),
+    )?;
     if !args.image.quiet {
         let seconds = stats.elapsed.as_secs_f64().max(1e-9);
         let range = match args.sampling.samples {
@@ -85,7 +96,12 @@ pub fn finish(args: &Args, plan: &Plan, prepared: &Prepared, rendered: Rendered)
 
 /// Why the render ended before its last pass (a time limit, convergence, a signal), how
 /// many samples adaptive sampling took, and how many samples were dropped.
-fn tell_how_it_ended(args: &Args, prepared: &Prepared, image: &crate::render::Image, stats: &RenderStats) {
+fn tell_how_it_ended(
+    args: &Args,
+    prepared: &Prepared,
+    image: &crate::render::Image,
+    stats: &RenderStats,
+) {
     let settings = &prepared.settings;
     let pixels = settings.width as f64 * settings.height as f64;
     let why = match stats.ended_early {

@@ -7,6 +7,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
+use super::LightSample;
+use super::tree::{Distant, TreeInput};
 use crate::render::sampling::{Distribution2d, uniform_sphere};
 use crate::scene::{Environment, EnvironmentMap, map_direction, map_uv};
 
@@ -54,6 +56,31 @@ impl EnvironmentLight {
         let wi = self.environment.world_from_map * local;
         let pdf = density / (2.0 * PI * PI * cos_latitude);
         Some((wi, self.radiance(wi), pdf))
+    }
+
+    /// A direction towards the environment from `p`, chosen with probability `pmf`, as a
+    /// light sample: a point `far` away, past the whole scene.
+    pub fn sample_from(&self, pmf: f32, p: Vec3, far: f32, u: Vec2) -> Option<LightSample> {
+        let (wi, radiance, pdf) = self.sample(u)?;
+        Some(LightSample {
+            point: p + far * wi,
+            point_error: Vec3::ZERO,
+            normal: -wi,
+            wi,
+            distance: far,
+            radiance,
+            pdf: pmf * pdf,
+            is_delta: false,
+        })
+    }
+
+    /// What the environment brings, for the light tree: the irradiance of its `power`
+    /// (what crosses the scene's disc of area `disc`) over that disc, from every side.
+    pub fn tree_input(power: f32, disc: f32) -> TreeInput {
+        TreeInput::Infinite(Distant {
+            irradiance: if disc > 0.0 { power / disc } else { power },
+            towards: None,
+        })
     }
 
     /// The solid-angle density with which [`EnvironmentLight::sample`] draws `direction`.

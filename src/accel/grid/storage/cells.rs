@@ -2,10 +2,10 @@
 //!
 //! The cells are grouped in macrocells of 8³. One word per macrocell says where its record
 //! is, or that it is empty; for an empty macrocell, a box per octant of directions says how
-//! far empty space reaches from it ([`super::reach`]), so the walk can leap over a whole box
+//! far empty space reaches from it ([`crate::accel::grid::storage::reach`]), so the walk can leap over a whole box
 //! of empty cells. An occupied macrocell has a record of the 512 occupancy bits of its
 //! cells and the ranks, and beside it, for each octant, how far empty space reaches from
-//! each cell (or 2³ unit of cells, [`super::cell_reach`]); a ray entering the macrocell
+//! each cell (or 2³ unit of cells, [`crate::accel::grid::storage::cell_reach`]); a ray entering the macrocell
 //! asks for the occupancy, the ranks and its own octant's reaches at once. Occupied cells
 //! are numbered macrocell by macrocell, so an occupied cell's number is its word's rank
 //! plus a popcount within one 64-bit word, and the offsets
@@ -17,14 +17,14 @@ use std::ops::Range;
 use glam::{IVec3, UVec3, Vec3A};
 use rayon::prelude::*;
 
-use super::box_counts::BoxCounts;
-use super::cell_reach;
-use super::reach;
+use crate::accel::grid::build::box_counts::BoxCounts;
+use crate::accel::grid::storage::cell_reach;
+use crate::accel::grid::storage::reach;
 
 /// A macrocell is 2^MACRO_SHIFT cells along each axis.
-pub(super) const MACRO_SHIFT: i32 = 3;
+pub(in crate::accel::grid) const MACRO_SHIFT: i32 = 3;
 /// Cells per macrocell.
-pub(super) const MACRO_CELLS: usize = 1 << (3 * MACRO_SHIFT);
+pub(in crate::accel::grid) const MACRO_CELLS: usize = 1 << (3 * MACRO_SHIFT);
 
 /// Set in a macrocell's word when it is occupied; the other bits are then its record's
 /// index. (An empty macrocell's word is 0.)
@@ -49,13 +49,13 @@ struct Record {
 }
 
 /// What the index says about one cell.
-pub(super) enum Lookup {
+pub(in crate::accel::grid) enum Lookup {
     /// The cell's macrocell is empty (how far empty space reaches from it is
     /// [`CellIndex::macrocell_of`]'s answer).
     EmptyMacrocell,
     /// The cell is empty (its macrocell is not), and so is the cube of `reach` cells a
     /// side that has the cell's unit ([`CellIndex::unit_shift`]) in its corner and extends
-    /// towards the octant asked about ([`super::cell_reach`]); for units of 2³ cells,
+    /// towards the octant asked about ([`crate::accel::grid::storage::cell_reach`]); for units of 2³ cells,
     /// `reach` is 0 when not even the unit is.
     EmptyCell { reach: u32 },
     /// The cell's blocks, and the cell's number among the occupied cells.
@@ -64,7 +64,7 @@ pub(super) enum Lookup {
 
 /// The two-level index of a grid's occupied cells.
 #[derive(Clone, Debug, Default)]
-pub(super) struct CellIndex {
+pub(in crate::accel::grid) struct CellIndex {
     /// Macrocells per axis.
     macro_resolution: UVec3,
     /// Where a macrocell's y and z coordinates are shifted to in its index
@@ -96,9 +96,9 @@ pub(super) struct CellIndex {
     /// For the k-th occupied cell, `offsets[k]..offsets[k + 1]` indexes the blocks.
     offsets: Vec<u32>,
     /// For the k-th occupied cell, the word of its triangles' box within it
-    /// ([`super::cell_box`]); empty for a grid that keeps no boxes.
+    /// ([`crate::accel::grid::storage::cell_box`]); empty for a grid that keeps no boxes.
     cell_boxes: Vec<u32>,
-    /// How far the walk grows each box ([`super::cell_box::margin_for`]); `None` for a grid that
+    /// How far the walk grows each box ([`crate::accel::grid::storage::cell_box::margin_for`]); `None` for a grid that
     /// keeps no boxes.
     box_margin: Option<Vec3A>,
 }
@@ -208,7 +208,7 @@ impl CellIndex {
         })
     }
 
-    /// Finds the reaches ([`super::cell_reach`]) of every occupied macrocell's units of
+    /// Finds the reaches ([`crate::accel::grid::storage::cell_reach`]) of every occupied macrocell's units of
     /// 2^`unit_shift` cells a side, in parallel over the macrocells, from their occupancy.
     pub fn fill_reaches(&mut self, unit_shift: u32) {
         let m = self.macro_resolution.as_ivec3();
@@ -244,7 +244,7 @@ impl CellIndex {
     }
 
     /// log2 of the side, in cells, of the units whose reaches the index keeps: the unit
-    /// shift [`crate::accel::frame::CellWalk::leave_cube`] takes.
+    /// shift [`crate::accel::grid::walk::frame::CellWalk::leave_cube`] takes.
     #[inline(always)]
     pub fn unit_shift(&self) -> u32 {
         self.unit_shift
@@ -297,7 +297,7 @@ impl CellIndex {
     /// several parts of them, one after another.
     #[inline(always)]
     pub fn prefetch_record<const UNIT: u32, const BOXED: bool>(&self, record: usize, octant: u32) {
-        use crate::accel::prefetch::prefetch;
+        use crate::accel::grid::walk::prefetch::prefetch;
         let r = &self.records[record];
         let start = self.reach_bytes::<UNIT>(record, octant);
         let lines = cell_reach::octant_bytes(UNIT).div_ceil(64);
@@ -376,7 +376,7 @@ impl CellIndex {
         self.offsets[k] as usize..self.offsets[k + 1] as usize
     }
 
-    /// Sets the occupied cells' box words ([`super::cell_box`]), in the order the cells are
+    /// Sets the occupied cells' box words ([`crate::accel::grid::storage::cell_box`]), in the order the cells are
     /// numbered, and the margin the walk grows them by.
     pub fn set_cell_boxes(&mut self, boxes: Vec<u32>, margin: Vec3A) {
         assert_eq!(boxes.len(), self.occupied());

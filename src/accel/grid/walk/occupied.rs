@@ -1,25 +1,25 @@
-//! The occupied cells along a ray, front to back: the walk of [`super::traverse`]'s
-//! queries through the two-level cell index ([`super::cells`]), one occupied cell ahead of
+//! The occupied cells along a ray, front to back: the walk of [`crate::accel::grid::walk`]'s
+//! queries through the two-level cell index ([`crate::accel::grid::storage::cells`]), one occupied cell ahead of
 //! the cell whose triangles are being tested.
 
 use std::ops::Range;
 
 use glam::{UVec3, Vec3A};
 
-use super::Grid;
-use super::block::Block;
-use super::cell_box::{self, MASKED_BLOCKS};
-use super::cells::{Lookup, MACRO_SHIFT};
-use super::reach;
-use super::traverse::TraversalStats;
+use super::stats::TraversalStats;
 use crate::accel::Ray;
-use crate::accel::frame::CellWalk;
-use crate::accel::prefetch::prefetch;
+use crate::accel::grid::Grid;
+use crate::accel::grid::storage::block::Block;
+use crate::accel::grid::storage::cell_box::{self, MASKED_BLOCKS};
+use crate::accel::grid::storage::cells::{Lookup, MACRO_SHIFT};
+use crate::accel::grid::storage::reach;
+use crate::accel::grid::walk::frame::CellWalk;
+use crate::accel::grid::walk::prefetch::prefetch;
 
 impl Grid {
     /// The occupied cells along `ray`, front to back.
     #[inline(always)]
-    pub(super) fn occupied_cells<
+    pub(in crate::accel::grid) fn occupied_cells<
         'a,
         const READ_BLOCKS: bool,
         const FUSED: bool,
@@ -51,7 +51,7 @@ impl Grid {
     /// The blocks of an occupied cell that its walk gives out ([`Found`]): for a grid that
     /// keeps boxes, those of `range` that `mask` holds, then any after the first 64.
     #[inline(always)]
-    pub(super) fn cell_blocks<const BOXED: bool>(
+    pub(in crate::accel::grid) fn cell_blocks<const BOXED: bool>(
         &self,
         range: &Range<usize>,
         mask: u64,
@@ -71,7 +71,7 @@ fn every_block(count: usize) -> u64 {
 }
 
 /// The blocks of a cell to test ([`Grid::cell_blocks`]).
-pub(super) struct CellBlocks<'a, const BOXED: bool> {
+pub(in crate::accel::grid) struct CellBlocks<'a, const BOXED: bool> {
     blocks: &'a [Block],
     /// The blocks among the first 64 not yet given out.
     mask: u64,
@@ -103,9 +103,9 @@ impl<'a, const BOXED: bool> Iterator for CellBlocks<'a, BOXED> {
 /// The occupied cells along a ray, front to back (a cursor rather than an iterator, so the
 /// caller's statistics can ride along). Unless `READ_BLOCKS`, the cells' blocks are not
 /// asked for ahead of time ([`Grid::walk`]). `FUSED` as in [`CellWalk`]; `UNIT` the grid's
-/// [`super::cells::CellIndex::unit_shift`]; `BOXED` when the grid keeps a box per occupied
+/// [`crate::accel::grid::storage::cells::CellIndex::unit_shift`]; `BOXED` when the grid keeps a box per occupied
 /// cell ([`cell_box`]).
-pub(super) struct OccupiedCells<
+pub(in crate::accel::grid) struct OccupiedCells<
     'a,
     const READ_BLOCKS: bool,
     const FUSED: bool,
@@ -156,7 +156,7 @@ impl Ahead {
 /// a grid that keeps boxes, [`cell_box::block_mask`]; bit `i` for the `i`-th block of the
 /// first 64, every block after them), and the largest hit parameter that belongs to it (the
 /// last cell takes all up to the grid's end).
-pub(super) type Found = (Range<usize>, u64, f32);
+pub(in crate::accel::grid) type Found = (Range<usize>, u64, f32);
 
 impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32, const BOXED: bool>
     OccupiedCells<'_, READ_BLOCKS, FUSED, UNIT, BOXED>
@@ -180,7 +180,10 @@ impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32, const BOXED: b
     /// (bounce and shadow rays, leaving the surface they start on) walks on as before:
     /// stopping cost its bounce rays 0.93× the speed.
     #[inline(always)]
-    pub(super) fn next(&mut self, stats: &mut impl TraversalStats) -> Option<Found> {
+    pub(in crate::accel::grid) fn next(
+        &mut self,
+        stats: &mut impl TraversalStats,
+    ) -> Option<Found> {
         let grid = self.grid;
         if self.single_cell {
             self.single_cell = false;
@@ -250,7 +253,7 @@ impl<const READ_BLOCKS: bool, const FUSED: bool, const UNIT: u32, const BOXED: b
                     Lookup::EmptyCell { reach } if reach >= 2 => {
                         stats.leap_cells();
                         // Past the empty cube of `reach` cells ahead
-                        // ([`super::cell_reach`]).
+                        // ([`crate::accel::grid::storage::cell_reach`]).
                         if !walk.leave_cube(reach as f32, UNIT) {
                             self.walk = None;
                             return Ahead::Found(None);

@@ -2,7 +2,7 @@
 //! macrocell: for each of the eight octants of directions, the side (in cells, up to
 //! [`MAX_REACH`]) of the largest cube of empty cells that has the cell's *unit* in its
 //! corner and extends in that octant's directions — the octant reaches of
-//! [`super::reach`], one level down. Most of a walk's steps are through empty cells of
+//! [`crate::accel::grid::storage::reach`], one level down. Most of a walk's steps are through empty cells of
 //! macrocells a surface passes through; a ray moving into the octant stays in the cube
 //! until it crosses one of its far faces, so the walk leaves the whole cube in one step.
 //! Unlike a distance to the nearest occupied cell (proximity clouds, Cohen & Sheffer 1994,
@@ -25,8 +25,8 @@
 //! `and`s per row (along x, then y, then z) per side. A 2³ unit's reach is then that of
 //! its cell nearest the octant's origin, whose cubes of two or more cells cover the unit.
 
-use super::cells::MACRO_CELLS;
-use super::reach::moves_up;
+use crate::accel::grid::storage::cells::MACRO_CELLS;
+use crate::accel::grid::storage::reach::moves_up;
 
 /// Cells along a macrocell's edge.
 const SIDE: usize = 8;
@@ -34,32 +34,32 @@ const SIDE: usize = 8;
 const WINDOW: usize = 3 * SIDE;
 /// Reaches are found up to this side; a cube of side `MAX_REACH` from any cell of the
 /// macrocell stays within the macrocell and its neighbours towards the octant.
-pub(super) const MAX_REACH: u32 = SIDE as u32;
+pub(in crate::accel::grid) const MAX_REACH: u32 = SIDE as u32;
 
 /// Grids whose blocks take more bytes than this keep reaches per 2³ unit of cells, the
 /// others per cell ([`unit_shift_for`]). Between the 203k dragon's 23 MB of blocks (2³
 /// units: 0.97–1.07 the time of per-cell reaches, mixed) and the full dragon's 88 MB
 /// (0.94–0.95 on outside, bounce and shadow rays, 1.04 on camera rays): about where the
 /// blocks outgrow a large last-level cache.
-pub(super) const LARGE_BLOCKS: usize = 48 << 20;
+pub(in crate::accel::grid) const LARGE_BLOCKS: usize = 48 << 20;
 
 /// log2 of a unit's side for a grid whose blocks take `block_bytes`: 0 (a unit is a cell)
 /// or 1 (2³ cells).
-pub(super) fn unit_shift_for(block_bytes: usize) -> u32 {
+pub(in crate::accel::grid) fn unit_shift_for(block_bytes: usize) -> u32 {
     u32::from(block_bytes > LARGE_BLOCKS)
 }
 
 /// Bytes of one octant's reaches of a macrocell's units of 2^`unit_shift` cells a side,
 /// two to a byte.
 #[inline(always)]
-pub(super) fn octant_bytes(unit_shift: u32) -> usize {
+pub(in crate::accel::grid) fn octant_bytes(unit_shift: u32) -> usize {
     (MACRO_CELLS >> (3 * unit_shift)) / 2
 }
 
 /// The nibble of cell `l` (its index within the macrocell, x + 8y + 64z) among its
 /// macrocell's units of 2^`unit_shift` cells a side (numbered x fastest).
 #[inline(always)]
-pub(super) fn unit_of(l: usize, unit_shift: u32) -> usize {
+pub(in crate::accel::grid) fn unit_of(l: usize, unit_shift: u32) -> usize {
     match unit_shift {
         0 => l,
         _ => (l & 7) >> 1 | (l >> 4 & 3) << 2 | (l >> 7 & 3) << 4,
@@ -69,7 +69,7 @@ pub(super) fn unit_of(l: usize, unit_shift: u32) -> usize {
 /// The reach (0 or 2 to [`MAX_REACH`] for units of 2³; 0 to [`MAX_REACH`] for cells) in
 /// nibble `u` of an octant's reaches `bytes`.
 #[inline(always)]
-pub(super) fn nibble(bytes: &[u8], u: usize) -> u32 {
+pub(in crate::accel::grid) fn nibble(bytes: &[u8], u: usize) -> u32 {
     u32::from(bytes[u >> 1] >> ((u & 1) * 4)) & 0xf
 }
 
@@ -79,11 +79,11 @@ pub(super) fn nibble(bytes: &[u8], u: usize) -> u32 {
 struct CellReaches([u8; MACRO_CELLS / 2]);
 
 /// The reaches of a macrocell's units of 2^`unit_shift` cells a side, octant by octant
-/// (as [`super::reach::octant`] numbers them; [`octant_bytes`] each), from the occupancy
+/// (as [`crate::accel::grid::storage::reach::octant`] numbers them; [`octant_bytes`] each), from the occupancy
 /// of it and its neighbours: `neighbour(dx, dy, dz)` (each −1, 0 or 1) gives a neighbour's
 /// occupancy words (bit `x + 8y` of word `z` for its cell (x, y, z)), `None` where it is
 /// empty or outside the grid (outside counts as empty: a ray there has left the grid).
-pub(super) fn reaches(
+pub(in crate::accel::grid) fn reaches(
     neighbour: impl Fn(i32, i32, i32) -> Option<[u64; SIDE]>,
     unit_shift: u32,
 ) -> Vec<u8> {

@@ -1,19 +1,27 @@
 //! Grid construction: resolution, then count → prefix sums → fill into compact storage.
 
+pub(in crate::accel::grid) mod block_order;
+pub(in crate::accel::grid) mod box_counts;
+pub(in crate::accel::grid) mod cell_order;
+pub mod density;
+pub(in crate::accel::grid) mod mesh_triangles;
+pub(in crate::accel::grid) mod overlap;
+
 use glam::{IVec3, UVec3, Vec3};
 use rayon::prelude::*;
 
-use super::block::{Block, LANES};
-use super::block_order::{self, CellRun};
-use super::cell_box::{self, Kept};
-use super::cell_order::{Buckets, CellOrder, KeyParts};
-use super::cells::{CellIndex, MACRO_CELLS};
-use super::mesh_triangles::MeshTriangles;
-use super::overlap::{Polygon, TriangleBoxTest};
-use super::{Grid, density};
+use super::Grid;
+use crate::accel::grid::storage::block::{Block, LANES};
+use crate::accel::grid::storage::cell_box::{self, Kept};
+use crate::accel::grid::storage::cells::{CellIndex, MACRO_CELLS};
+use block_order::CellRun;
+use cell_order::{Buckets, CellOrder, KeyParts};
+use mesh_triangles::MeshTriangles;
+use overlap::{Polygon, TriangleBoxTest};
+
 #[cfg(target_arch = "x86_64")]
 use crate::accel::cpu::x86_fast_path;
-use crate::accel::frame::{GridFrame, padded, resolution};
+use crate::accel::grid::walk::frame::{GridFrame, padded, resolution};
 use crate::accel::{Triangle, huge_pages};
 use crate::scene::Aabb;
 
@@ -28,7 +36,7 @@ enum Boxes {
 }
 
 /// Meshes of at most this many triangles (two blocks) get a single cell: a wall, a box.
-pub(super) const SINGLE_CELL_MAX: usize = 2 * LANES;
+pub(in crate::accel::grid) const SINGLE_CELL_MAX: usize = 2 * LANES;
 
 /// Bounding boxes of at most this many cells are tested cell by cell; larger ones are
 /// walked slab by slab (clipping costs more than it saves on a few cells).
@@ -63,7 +71,7 @@ impl Grid {
     /// Builds a grid over a triangle soup with about `density` cells per triangle, keeping
     /// boxes whatever its size (for tests: only large grids keep them otherwise).
     #[cfg(test)]
-    pub(super) fn build_boxed(triangles: Vec<Triangle>, density: f32) -> Grid {
+    pub(in crate::accel::grid) fn build_boxed(triangles: Vec<Triangle>, density: f32) -> Grid {
         let (vertices, indices) = soup(&triangles);
         Grid::build_mesh(vertices, &indices, Some(density), Boxes::Always)
     }
@@ -242,7 +250,7 @@ impl Grid {
     /// Every block's box word within its cell, found from the written blocks (for tests: the
     /// build finds them as it writes the blocks).
     #[cfg(test)]
-    pub(super) fn block_box_words(&self) -> Vec<u32> {
+    pub(in crate::accel::grid) fn block_box_words(&self) -> Vec<u32> {
         let cells = self.cells.occupied_cells();
         let mut words = vec![0; self.blocks.len()];
         for (k, &c) in cells.iter().enumerate() {
@@ -256,7 +264,7 @@ impl Grid {
     /// Every occupied cell's box word, in the order the cells are numbered, found from the
     /// written blocks (for tests: the build finds them as it writes the blocks).
     #[cfg(test)]
-    pub(super) fn cell_boxes(&self) -> Vec<u32> {
+    pub(in crate::accel::grid) fn cell_boxes(&self) -> Vec<u32> {
         let cells = self.cells.occupied_cells();
         cells
             .iter()
@@ -437,7 +445,7 @@ impl Grid {
 }
 
 /// The vertices and indices of a triangle soup, three corners per triangle.
-pub(super) fn soup(triangles: &[Triangle]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+pub(in crate::accel::grid) fn soup(triangles: &[Triangle]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let vertices = triangles.iter().flat_map(|t| t.vertices()).collect();
     let indices = (0..triangles.len() as u32)
         .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])

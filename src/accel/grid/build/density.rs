@@ -16,8 +16,8 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use rayon::prelude::*;
 
-use super::mesh_triangles::MeshTriangles;
-use crate::accel::frame::{GridFrame, resolution};
+use crate::accel::grid::build::mesh_triangles::MeshTriangles;
+use crate::accel::grid::walk::frame::{GridFrame, resolution};
 use crate::scene::Aabb;
 
 /// λ for evenly spread triangles (the Stanford dragons of 11k and 203k triangles: 1.02–1.10×
@@ -38,7 +38,11 @@ pub const UNEVEN_DENSITY: f32 = 5.0;
 pub const EVEN_CROWDING: f64 = 16.0;
 
 /// The density for the live triangles of `triangles` (numbered in `live`) in `bounds`.
-pub(super) fn density_for(bounds: Aabb, triangles: MeshTriangles, live: &[u32]) -> f32 {
+pub(in crate::accel::grid) fn density_for(
+    bounds: Aabb,
+    triangles: MeshTriangles,
+    live: &[u32],
+) -> f32 {
     let crowding = crowding(bounds, triangles, live);
     if crowding <= EVEN_CROWDING {
         return EVEN_DENSITY;
@@ -49,7 +53,11 @@ pub(super) fn density_for(bounds: Aabb, triangles: MeshTriangles, live: &[u32]) 
 
 /// Σ n² / Σ n over the cells of a grid of [`EVEN_DENSITY`] over `bounds`, n the number of
 /// triangle centroids in a cell: the centroid count of an average triangle's cell.
-pub(super) fn crowding(bounds: Aabb, triangles: MeshTriangles, live: &[u32]) -> f64 {
+pub(in crate::accel::grid) fn crowding(
+    bounds: Aabb,
+    triangles: MeshTriangles,
+    live: &[u32],
+) -> f64 {
     if live.is_empty() {
         return 0.0;
     }

@@ -10,7 +10,7 @@ use crate::accel::Triangle;
 
 /// A triangle list seen through an indexed mesh.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct MeshTriangles<'a> {
+pub(in crate::accel::grid) struct MeshTriangles<'a> {
     vertices: &'a [Vec3],
     indices: &'a [[u32; 3]],
 }

@@ -21,18 +21,18 @@
 //! [`MAX_SIDE`] cells, so the three fit in a byte each ([`CellIndex`]); found by bisection,
 //! each box's occupied cells counted from a table of sums ([`BoxCounts`]).
 //!
-//! [`CellIndex`]: super::cells::CellIndex
+//! [`CellIndex`]: crate::accel::grid::storage::cells::CellIndex
 
 use glam::IVec3;
 use rayon::prelude::*;
 
-use super::box_counts::BoxCounts;
-use super::cells::MACRO_SHIFT;
+use crate::accel::grid::build::box_counts::BoxCounts;
+use crate::accel::grid::storage::cells::MACRO_SHIFT;
 
 /// The longest side of a box, in cells: a side fits in a byte. (A ray through a grid of
 /// the largest resolution, 2048 cells a side, thus leaps at least nine times over empty
 /// space along it.)
-pub(super) const MAX_SIDE: i32 = 255;
+pub(in crate::accel::grid) const MAX_SIDE: i32 = 255;
 
 /// Cells along a macrocell's edge.
 const MACRO_SIDE: i32 = 1 << MACRO_SHIFT;
@@ -40,34 +40,44 @@ const MACRO_SIDE: i32 = 1 << MACRO_SHIFT;
 /// The octant of a walk's direction: bit `a` set when it moves down axis `a` (a ray
 /// parallel to an axis counts as moving up it: it never leaves its slab of that axis).
 #[inline(always)]
-pub(super) fn octant(step: IVec3) -> u32 {
+pub(in crate::accel::grid) fn octant(step: IVec3) -> u32 {
     u32::from(step.x < 0) | u32::from(step.y < 0) << 1 | u32::from(step.z < 0) << 2
 }
 
 /// True when a walk moving into `octant` moves up (or along) `axis` ([`octant`]).
 #[inline(always)]
-pub(super) fn moves_up(octant: u32, axis: usize) -> bool {
+pub(in crate::accel::grid) fn moves_up(octant: u32, axis: usize) -> bool {
     octant >> axis & 1 == 0
 }
 
 /// The cells `(lo, hi)` (inclusive) of the box of `sides` cells that has the unit of `unit`
 /// cells a side starting at cell `corner` in its corner and extends towards `octant`: the
 /// box a reach promises empty (of a cell: `unit` 1; of a macrocell: its edge).
-pub(super) fn box_cells(corner: IVec3, unit: i32, octant: u32, sides: IVec3) -> (IVec3, IVec3) {
+pub(in crate::accel::grid) fn box_cells(
+    corner: IVec3,
+    unit: i32,
+    octant: u32,
+    sides: IVec3,
+) -> (IVec3, IVec3) {
     let up = IVec3::from_array([0, 1, 2].map(|a| i32::from(moves_up(octant, a))));
     let lo = corner + (IVec3::ONE - up) * (IVec3::splat(unit) - sides);
     (lo, lo + sides - 1)
 }
 
 /// [`box_cells`] of a cube of `side` cells a side.
-pub(super) fn cube_box(corner: IVec3, unit: i32, octant: u32, side: i32) -> (IVec3, IVec3) {
+pub(in crate::accel::grid) fn cube_box(
+    corner: IVec3,
+    unit: i32,
+    octant: u32,
+    side: i32,
+) -> (IVec3, IVec3) {
     box_cells(corner, unit, octant, IVec3::splat(side))
 }
 
 /// Per macrocell of a grid of `resolution` macrocells (x fastest) whose occupied cells
 /// `cells` counts, and per octant: the sides of its box (above), packed a byte each, x
 /// lowest; 0 for an occupied macrocell.
-pub(super) fn boxes(resolution: IVec3, cells: &BoxCounts) -> Vec<[u32; 8]> {
+pub(in crate::accel::grid) fn boxes(resolution: IVec3, cells: &BoxCounts) -> Vec<[u32; 8]> {
     let r = resolution;
     let count = (r.x * r.y * r.z) as usize;
     (0..count)
@@ -112,12 +122,12 @@ fn largest(low: i32, fits: impl Fn(i32) -> bool) -> i32 {
 }
 
 /// A box's sides (each in `1..=MAX_SIDE`), a byte each, x lowest.
-pub(super) fn pack(sides: IVec3) -> u32 {
+pub(in crate::accel::grid) fn pack(sides: IVec3) -> u32 {
     sides.x as u32 | (sides.y as u32) << 8 | (sides.z as u32) << 16
 }
 
 /// The sides [`pack`] packed.
-pub(super) fn unpack(packed: u32) -> IVec3 {
+pub(in crate::accel::grid) fn unpack(packed: u32) -> IVec3 {
     IVec3::new(
         (packed & 0xff) as i32,
         (packed >> 8 & 0xff) as i32,

@@ -1,4 +1,4 @@
-//! The triangles of each crowded cell of a grid that keeps boxes ([`super::cell_box`]) in
+//! The triangles of each crowded cell of a grid that keeps boxes ([`crate::accel::grid::storage::cell_box`]) in
 //! Morton order of where they lie in the cell, so that each block's eight triangles lie near
 //! each other and its box is small: the walk then tests only the blocks whose boxes the ray
 //! meets, and asks memory for only those.
@@ -13,19 +13,19 @@
 use glam::{IVec3, UVec3, Vec3};
 use rayon::prelude::*;
 
-use super::mesh_triangles::MeshTriangles;
-use crate::accel::frame::GridFrame;
+use crate::accel::grid::build::mesh_triangles::MeshTriangles;
+use crate::accel::grid::walk::frame::GridFrame;
 use crate::scene::Aabb;
 
 /// Steps per cell along each axis of the key (4 bits).
 const STEPS: f32 = 16.0;
 
 /// A run of `sorted`: the cell's triangles from `start`, `count` of them.
-pub(super) type CellRun = (u32, u32, IVec3);
+pub(in crate::accel::grid) type CellRun = (u32, u32, IVec3);
 
 /// Puts the triangles of each of `runs` (cells, in the order of their runs in `sorted`, that
 /// do not overlap) in Morton order within its cell.
-pub(super) fn order_cells(
+pub(in crate::accel::grid) fn order_cells(
     frame: &GridFrame,
     sorted: &mut [u32],
     runs: &[CellRun],
@@ -52,7 +52,7 @@ pub(super) fn order_cells(
 }
 
 /// The Morton code of the centre of `bounds` clamped to cell `cell`.
-pub(super) fn key(frame: &GridFrame, cell: IVec3, bounds: Aabb) -> u32 {
+pub(in crate::accel::grid) fn key(frame: &GridFrame, cell: IVec3, bounds: Aabb) -> u32 {
     let corner = frame.bounds.min + cell.as_vec3() * frame.cell_size;
     let lo = bounds.min.max(corner);
     let hi = bounds.max.min(corner + frame.cell_size);

@@ -10,7 +10,7 @@
 //! slab (its corners inside and its edges' crossings of the slab's planes: exact for a
 //! triangle that crosses the faces of one axis). The bounds are kept in 31sts of the cell,
 //! rounded outwards, 5 bits a bound: a 32-bit word per occupied cell in an array beside the
-//! cells' offsets ([`super::cells`]), whose first two lines a ray entering the macrocell
+//! cells' offsets ([`crate::accel::grid::storage::cells`]), whose first two lines a ray entering the macrocell
 //! asks for with the record. The build finds each block's box as it writes the block, for
 //! its eight triangles at once and without a branch ([`block_word`]), and joins a cell's;
 //! the full dragon's build takes 0.11–0.13 s (0.10 s without boxes, Embree 0.16–0.17).
@@ -34,7 +34,7 @@
 //!
 //! Grids whose blocks outgrow even the last-level cache ([`MASKED_BLOCKS_FROM`]) keep each
 //! block's word too, and order the triangles of each cell of several blocks so that a
-//! block's eight lie together ([`super::block_order`]). When the walk finds such a cell
+//! block's eight lie together ([`crate::accel::grid::build::block_order`]). When the walk finds such a cell
 //! whose box the ray meets, it tests the boxes of its blocks ([`block_mask`]) and asks
 //! memory for, and tests, only the blocks whose boxes the ray meets (thirty-first
 //! session). Answers are again those of the grid without boxes, but for ties between equal
@@ -44,9 +44,9 @@ use std::ops::Range;
 
 use glam::{IVec3, Vec3, Vec3A};
 
-use super::block::{Block, LANES};
 use crate::accel::Triangle;
-use crate::accel::frame::{CellWalk, GridFrame};
+use crate::accel::grid::storage::block::{Block, LANES};
+use crate::accel::grid::walk::frame::{CellWalk, GridFrame};
 use crate::scene::Aabb;
 
 /// Grids whose blocks take more bytes than this keep a box per occupied cell: about half a
@@ -54,7 +54,7 @@ use crate::scene::Aabb;
 /// time, bounce 0.96, shadow 0.86; in cache 0.94, 0.95, 0.94), while the 47k dragon's
 /// 6.5 MB and the 11k's 1.8 MB, which stay in the caches, lost 1–4 % even with the test
 /// after their blocks were asked for.
-pub(super) const BOXED_BLOCKS: usize = 16 << 20;
+pub(in crate::accel::grid) const BOXED_BLOCKS: usize = 16 << 20;
 
 /// Steps per cell along each axis of a box's bounds (5 bits: 0 to 31).
 const STEPS: f32 = 31.0;
@@ -63,7 +63,7 @@ const STEPS: f32 = 31.0;
 const BITS: u32 = 5;
 
 /// The box word of a whole cell.
-pub(super) const WHOLE: u32 = 0x3fff_8000;
+pub(in crate::accel::grid) const WHOLE: u32 = 0x3fff_8000;
 
 /// The box word of nothing (lower bounds above upper ones), which [`join_all`] starts from.
 const NOTHING: u32 = 0x7fff;
@@ -75,10 +75,10 @@ const NOTHING: u32 = 0x7fff;
 /// 1.04; in cache 1.03 / 1.09 / 1.07 / 1.00 / 1.00), while the 203k dragon's 23 MB lost
 /// 1–10 % (in cache 7–11 %): where the blocks stay in the caches, the masks cost more than
 /// the blocks they spare (measured at 6d13fe3).
-pub(super) const MASKED_BLOCKS_FROM: usize = 48 << 20;
+pub(in crate::accel::grid) const MASKED_BLOCKS_FROM: usize = 48 << 20;
 
 /// Which boxes a grid whose blocks take `block_bytes` keeps.
-pub(super) fn boxes_for(block_bytes: usize) -> Kept {
+pub(in crate::accel::grid) fn boxes_for(block_bytes: usize) -> Kept {
     match block_bytes {
         b if b > MASKED_BLOCKS_FROM => Kept::CellsAndBlocks,
         b if b > BOXED_BLOCKS => Kept::Cells,
@@ -88,12 +88,12 @@ pub(super) fn boxes_for(block_bytes: usize) -> Kept {
 
 /// The boxes a grid keeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Kept {
+pub(in crate::accel::grid) enum Kept {
     None,
     /// A box per occupied cell.
     Cells,
     /// A box per occupied cell and per block, with each crowded cell's triangles in Morton
-    /// order ([`super::block_order`]).
+    /// order ([`crate::accel::grid::build::block_order`]).
     CellsAndBlocks,
 }
 
@@ -102,7 +102,7 @@ pub(super) enum Kept {
 /// walk may land in by rounding) twice over, and never less than 1/128 cell (for the test's
 /// own rounding). `None` when that is a quarter of a cell or more, where a box would seldom
 /// pass anything (a grid far from its origin for its size).
-pub(super) fn margin_for(frame: &GridFrame) -> Option<Vec3A> {
+pub(in crate::accel::grid) fn margin_for(frame: &GridFrame) -> Option<Vec3A> {
     let margin = (2.0 * frame.pad() * frame.inv_cell_size).max(Vec3::splat(1.0 / 128.0));
     (margin.max_element() < 0.25).then_some(margin.into())
 }
@@ -119,7 +119,7 @@ type LanePoints = [Lanes; 3];
 /// outcome is as good as random, the box pass took 0.05 s of the full dragon's 0.15 s
 /// build; this way it takes about 0.02 s.
 #[inline(always)]
-pub(super) fn block_word(frame: &GridFrame, c: IVec3, block: &Block) -> u32 {
+pub(in crate::accel::grid) fn block_word(frame: &GridFrame, c: IVec3, block: &Block) -> u32 {
     let cell = CellBounds::new(frame, c);
     let (corners, used) = block.corners();
     word(frame, &cell, cell.lanes_part(&corners, used))
@@ -128,7 +128,7 @@ pub(super) fn block_word(frame: &GridFrame, c: IVec3, block: &Block) -> u32 {
 /// The word of the box of the parts within cell `c` of `triangles`, found triangle by
 /// triangle: what [`block_word`] must find for a block of them.
 #[cfg(test)]
-pub(super) fn triangles_word(
+pub(in crate::accel::grid) fn triangles_word(
     frame: &GridFrame,
     c: IVec3,
     triangles: impl IntoIterator<Item = Triangle>,
@@ -152,7 +152,7 @@ fn word(frame: &GridFrame, cell: &CellBounds, part: Aabb) -> u32 {
 /// The box word that holds the boxes `words` hold (those of one cell's blocks); a whole
 /// cell if they hold nothing (rounding may clip away a triangle that touches the grown cell
 /// only at a corner).
-pub(super) fn join_all(words: &[u32]) -> u32 {
+pub(in crate::accel::grid) fn join_all(words: &[u32]) -> u32 {
     let field = |word: u32, i: u32| (word >> (BITS * i)) & ((1 << BITS) - 1);
     let joined = words.iter().fold(NOTHING, |joined, &word| {
         (0..6).fold(0, |out, i| {
@@ -285,7 +285,7 @@ fn greatest(a: f32, b: f32) -> f32 {
 
 /// The word of the box from `lo` to `hi` (in cells from the cell's lower corner), each
 /// bound clamped to the cell and rounded outwards to a 31st.
-pub(super) fn encode(lo: Vec3, hi: Vec3) -> u32 {
+pub(in crate::accel::grid) fn encode(lo: Vec3, hi: Vec3) -> u32 {
     let lo = (lo.clamp(Vec3::ZERO, Vec3::ONE) * STEPS).floor().as_uvec3();
     let hi = (hi.clamp(Vec3::ZERO, Vec3::ONE) * STEPS)
         .ceil()
@@ -298,7 +298,7 @@ pub(super) fn encode(lo: Vec3, hi: Vec3) -> u32 {
 /// The bounds a box word holds, in 31sts of a cell from the cell's lower corner: lower,
 /// upper.
 #[inline(always)]
-pub(super) fn decode<const FUSED: bool>(word: u32) -> (Vec3A, Vec3A) {
+pub(in crate::accel::grid) fn decode<const FUSED: bool>(word: u32) -> (Vec3A, Vec3A) {
     #[cfg(target_arch = "x86_64")]
     if FUSED {
         use std::arch::x86_64::{
@@ -325,7 +325,11 @@ pub(super) fn decode<const FUSED: bool>(word: u32) -> (Vec3A, Vec3A) {
 /// True unless the walk's ray passes the box `word` of its current cell, grown by
 /// `margin` cells ([`margin_for`]).
 #[inline(always)]
-pub(super) fn meets<const FUSED: bool>(walk: &CellWalk<FUSED>, word: u32, margin: Vec3A) -> bool {
+pub(in crate::accel::grid) fn meets<const FUSED: bool>(
+    walk: &CellWalk<FUSED>,
+    word: u32,
+    margin: Vec3A,
+) -> bool {
     let (lo, hi) = decode::<FUSED>(word);
     walk.meets_box(lo, hi, 1.0 / STEPS, margin)
 }
@@ -337,7 +341,7 @@ pub(super) fn meets<const FUSED: bool>(walk: &CellWalk<FUSED>, word: u32, margin
 /// decoded lane by lane, took 1.04–1.06 the time of this on the full dragon's outside,
 /// bounce and light rays (measured at 6d13fe3).
 #[inline(always)]
-pub(super) fn block_mask<const FUSED: bool>(
+pub(in crate::accel::grid) fn block_mask<const FUSED: bool>(
     walk: &CellWalk<FUSED>,
     words: &[u32],
     blocks: Range<usize>,
@@ -352,12 +356,12 @@ pub(super) fn block_mask<const FUSED: bool>(
 }
 
 /// Blocks of a cell that [`block_mask`] answers for.
-pub(super) const MASKED_BLOCKS: usize = 64;
+pub(in crate::accel::grid) const MASKED_BLOCKS: usize = 64;
 
 /// True when the box `word` of cell `c`, grown by `margin`, holds every point of
 /// `triangle` within the cell grown by [`GridFrame::pad`]: what the walk relies on
-/// ([`super::Grid::validate`]).
-pub(super) fn holds(
+/// ([`crate::accel::grid::Grid::validate`]).
+pub(in crate::accel::grid) fn holds(
     frame: &GridFrame,
     c: IVec3,
     word: u32,

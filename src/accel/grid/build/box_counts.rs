@@ -1,13 +1,13 @@
 //! Counting the occupied cells of any box of a 3D grid in constant time, from a table of
 //! sums (a summed-area table in three dimensions, Crow 1984): for finding how far the
-//! walk may leap from an empty macrocell ([`super::reach`]), and for checking that no
+//! walk may leap from an empty macrocell ([`crate::accel::grid::storage::reach`]), and for checking that no
 //! leap passes over an occupied cell.
 
 use glam::IVec3;
 use rayon::prelude::*;
 
 /// Occupied cells per box of a grid of `resolution` cells.
-pub(super) struct BoxCounts {
+pub(in crate::accel::grid) struct BoxCounts {
     resolution: IVec3,
     /// `sums[(x, y, z)]`: occupied cells with all coordinates below (x, y, z); one more
     /// entry than cells along each axis.

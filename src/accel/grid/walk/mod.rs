@@ -1,98 +1,26 @@
 //! Ray traversal: the 3D-DDA of Amanatides & Woo (1987), "A fast voxel traversal algorithm
-//! for ray tracing", over the two-level cell index ([`super::cells`]): an empty macrocell
-//! sends the walk past the whole empty box ahead of it in one step ([`super::reach`]), an
+//! for ray tracing", over the two-level cell index ([`crate::accel::grid::storage::cells`]): an empty macrocell
+//! sends the walk past the whole empty box ahead of it in one step ([`crate::accel::grid::storage::reach`]), an
 //! empty cell past the empty cube ahead of it (or of its 2³ unit of cells) if that is two
-//! or more cells a side ([`super::cell_reach`]), any other empty cell costs a bit test and
+//! or more cells a side ([`crate::accel::grid::storage::cell_reach`]), any other empty cell costs a bit test and
 //! a step, and an
 //! occupied cell's blocks are tested eight triangles at a time. A grid of one cell is not
 //! walked: its blocks are tested at once.
 
 use glam::UVec3;
 
+pub(crate) mod cell_lanes;
+pub(crate) mod frame;
+pub(in crate::accel::grid) mod occupied;
+pub(crate) mod prefetch;
+mod stats;
+
+pub use stats::{TraversalCounts, TraversalStats};
+
 use super::{Grid, GridHit};
 use crate::accel::Ray;
 #[cfg(target_arch = "x86_64")]
 use crate::accel::cpu::{X86Level, x86_level};
-
-/// Counts the work a traversal does, for the benchmark's statistics. The unit type counts
-/// nothing and compiles away.
-pub trait TraversalStats {
-    /// One cell (or one skipped stretch of empty macrocells) stepped through.
-    fn visit_cell(&mut self) {}
-    /// The walk entered an occupied macrocell (and asked for its record).
-    fn enter_macrocell(&mut self) {}
-    /// The walk leapt over a box of empty macrocells ([`super::reach`]).
-    fn leap_macrocells(&mut self) {}
-    /// The walk leapt over an empty cube of cells ([`super::cell_reach`]).
-    fn leap_cells(&mut self) {}
-    /// The walk stepped from an empty cell to the next one (plain 3D-DDA step).
-    fn step_cell(&mut self) {}
-    /// One occupied cell reached (its triangles are then tested).
-    fn visit_occupied(&mut self) {}
-    /// The walk ahead of a tested cell stopped at the next occupied macrocell
-    /// ([`OccupiedCells::next`]).
-    fn pause_ahead(&mut self) {}
-    /// Ray–triangle tests (the triangles of one block, tested together).
-    fn test_triangles(&mut self, _count: usize) {}
-    /// One instance considered by the top level (its bounding box tested, and its grid
-    /// walked if that is hit).
-    fn test_instance(&mut self) {}
-}
-
-impl TraversalStats for () {}
-
-/// Cells visited and triangles tested, summed over rays.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct TraversalCounts {
-    /// Cells and skipped stretches of empty macrocells stepped through.
-    pub cells: u64,
-    /// Entries into occupied macrocells (each asks for the macrocell's record).
-    pub macrocell_entries: u64,
-    /// Leaps over boxes of empty macrocells.
-    pub macrocell_leaps: u64,
-    /// Leaps over empty cubes of cells.
-    pub cell_leaps: u64,
-    /// Plain steps out of empty cells.
-    pub plain_steps: u64,
-    /// Occupied cells reached.
-    pub occupied: u64,
-    /// Walks ahead of a tested cell stopped at the next occupied macrocell.
-    pub pauses: u64,
-    /// Ray–triangle tests.
-    pub tests: u64,
-    /// Instances considered by the top level.
-    pub instances: u64,
-}
-
-impl TraversalStats for TraversalCounts {
-    fn visit_cell(&mut self) {
-        self.cells += 1;
-    }
-    fn enter_macrocell(&mut self) {
-        self.macrocell_entries += 1;
-    }
-    fn leap_macrocells(&mut self) {
-        self.macrocell_leaps += 1;
-    }
-    fn leap_cells(&mut self) {
-        self.cell_leaps += 1;
-    }
-    fn step_cell(&mut self) {
-        self.plain_steps += 1;
-    }
-    fn visit_occupied(&mut self) {
-        self.occupied += 1;
-    }
-    fn pause_ahead(&mut self) {
-        self.pauses += 1;
-    }
-    fn test_triangles(&mut self, count: usize) {
-        self.tests += count as u64;
-    }
-    fn test_instance(&mut self) {
-        self.instances += 1;
-    }
-}
 
 impl Grid {
     /// The closest hit along `ray`, if any.
@@ -115,7 +43,7 @@ impl Grid {
     }
 
     /// [`Grid::intersect_counting`] for a grid whose reaches are kept per unit of
-    /// 2^`UNIT` cells ([`super::cell_reach`]): each unit's walk compiled in functions of
+    /// 2^`UNIT` cells ([`crate::accel::grid::storage::cell_reach`]): each unit's walk compiled in functions of
     /// its own, so that neither pays for the other's code (in one function, the 11k
     /// dragon's queries took 1.01–1.03 the time).
     #[inline(always)]
@@ -334,9 +262,9 @@ impl Grid {
 mod tests {
     use glam::Vec3;
 
-    use super::super::cell_box::{self, MASKED_BLOCKS};
     use super::*;
     use crate::accel::Triangle;
+    use crate::accel::grid::storage::cell_box::{self, MASKED_BLOCKS};
 
     /// Asserts that `grid` answers the shadow query of ray `k` as `expected` does, in its
     /// fast walk and in its portable one (reaches per 2^`UNIT` cells, boxes if `BOXED`).
@@ -553,7 +481,7 @@ mod tests {
     }
 
     /// A grid whose reaches are kept per 2³ unit of cells (as a grid whose blocks outgrow
-    /// the caches keeps them, [`super::super::cell_reach::unit_shift_for`]) is valid and
+    /// the caches keeps them, [`crate::accel::grid::storage::cell_reach::unit_shift_for`]) is valid and
     /// finds, by other steps, exactly what the same grid with reaches per cell finds, for
     /// rays from outside and from among the cells, and the same shadow answers.
     #[test]
@@ -594,7 +522,7 @@ mod tests {
     }
 
     /// A grid that keeps a box per occupied cell (as a grid whose blocks outgrow the caches
-    /// does, [`super::super::cell_box::boxes_for`]) is valid, passes cells by their boxes,
+    /// does, [`crate::accel::grid::storage::cell_box::boxes_for`]) is valid, passes cells by their boxes,
     /// and finds exactly what the same grid without boxes finds, in both walks, with
     /// reaches per cell and per 2³ unit, for rays from outside and from among the cells,
     /// rays of huge and tiny direction vectors, and shadow segments; and a box that does

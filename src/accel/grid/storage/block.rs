@@ -10,18 +10,18 @@ use glam::Vec3;
 use crate::accel::{Ray, Triangle};
 
 /// Triangles per block.
-pub(super) const LANES: usize = 8;
+pub(in crate::accel::grid) const LANES: usize = 8;
 
 /// The id of an unused lane; its triangle (all zero) is never hit.
-pub(super) const NO_TRIANGLE: u32 = u32::MAX;
+pub(in crate::accel::grid) const NO_TRIANGLE: u32 = u32::MAX;
 
 /// Up to eight triangles as vertex and edges per axis, with their mesh indices. Aligned to
 /// cache lines, so that a block (five lines) never straddles a sixth, which the walk's
-/// request for its lines ([`crate::accel::prefetch::prefetch`]) would not ask for: the
+/// request for its lines ([`crate::accel::grid::walk::prefetch::prefetch`]) would not ask for: the
 /// allocator's placement of the block array does not decide it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
-pub(super) struct Block {
+pub(in crate::accel::grid) struct Block {
     v0: [[f32; LANES]; 3],
     e1: [[f32; LANES]; 3],
     e2: [[f32; LANES]; 3],
@@ -33,16 +33,16 @@ const _: () = assert!(std::mem::size_of::<Block>().is_multiple_of(64));
 
 /// The nearest hit in a block: lane, parameter and barycentrics.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct LaneHit {
+pub(in crate::accel::grid) struct LaneHit {
     pub t: f32,
     pub u: f32,
     pub v: f32,
     pub id: u32,
 }
 
-impl From<LaneHit> for super::GridHit {
-    fn from(hit: LaneHit) -> super::GridHit {
-        super::GridHit {
+impl From<LaneHit> for crate::accel::grid::GridHit {
+    fn from(hit: LaneHit) -> crate::accel::grid::GridHit {
+        crate::accel::grid::GridHit {
             t: hit.t,
             u: hit.u,
             v: hit.v,

@@ -10,7 +10,7 @@
 
 use rayon::prelude::*;
 
-use super::cells::MACRO_CELLS;
+use crate::accel::grid::storage::cells::MACRO_CELLS;
 
 /// Parts the keys are cut into, at most: enough for two threads to share the work evenly
 /// however the occupied macrocells cluster, few enough that a chunk's buckets stay small.
@@ -18,7 +18,7 @@ const MAX_PARTS: usize = 64;
 
 /// How the storage keys are cut into parts of whole macrocells.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct KeyParts {
+pub(in crate::accel::grid) struct KeyParts {
     /// Keys per part (the last may have fewer).
     part_keys: usize,
     /// Number of parts.
@@ -26,10 +26,10 @@ pub(super) struct KeyParts {
 }
 
 /// The pairs of one chunk of triangles, one bucket per part, each in the order made.
-pub(super) type Buckets = Vec<Vec<(u32, u32)>>;
+pub(in crate::accel::grid) type Buckets = Vec<Vec<(u32, u32)>>;
 
 /// Triangle numbers in cell order, and how they divide among the cells.
-pub(super) struct CellOrder {
+pub(in crate::accel::grid) struct CellOrder {
     /// Per storage key, the cell's number of triangles.
     pub counts: Vec<u32>,
     /// Per storage key in order, the cell's triangles in mesh order, all cells after one

@@ -4,8 +4,8 @@
 
 use glam::{BVec3A, IVec3, UVec3, Vec3, Vec3A, Vec3Swizzles};
 
-use super::Ray;
 use super::cell_lanes::CellLanes;
+use crate::accel::Ray;
 use crate::scene::Aabb;
 
 /// Most cells along one axis.
@@ -111,7 +111,7 @@ impl GridFrame {
         // clipped away by rounding (pbrt-v4 §6.8.2: t_far·(1 + 2γ(3))).
         let far = Vec3A::select(
             moving,
-            t0.max(t1) * (1.0 + 2.0 * super::SLAB_ROUNDING),
+            t0.max(t1) * (1.0 + 2.0 * crate::accel::SLAB_ROUNDING),
             Vec3A::select(inside, none, all),
         );
         let t_start = near.max_element().max(ray.t_min);

@@ -1,0 +1,38 @@
+#!/usr/bin/env python3
+"""Exits 0 when two OpenEXR files hold the same image: the same header attributes and,
+channel by channel, the same bits in every sample (so -0 against 0 or two NaNs of different
+payloads count as different). Their bytes may still differ: the `exr` crate writes
+compressed chunks in whatever order its threads finish them.
+
+    python3 tools/dev/exr-same.py A.exr B.exr
+
+Needs the PyPI packages OpenEXR and numpy."""
+import sys
+
+import numpy as np
+import OpenEXR
+
+
+def read(path):
+    with OpenEXR.File(path) as f:
+        header = {k: repr(v) for k, v in f.header().items()}
+        channels = {k: np.ascontiguousarray(v.pixels) for k, v in f.channels().items()}
+    return header, channels
+
+
+def main():
+    (ha, ca), (hb, cb) = read(sys.argv[1]), read(sys.argv[2])
+    problems = [f"header {k}: {ha.get(k)} != {hb.get(k)}" for k in sorted(set(ha) | set(hb)) if ha.get(k) != hb.get(k)]
+    for name in sorted(set(ca) | set(cb)):
+        a, b = ca.get(name), cb.get(name)
+        if a is None or b is None or a.shape != b.shape or a.dtype != b.dtype:
+            problems.append(f"channel {name}: present or shaped differently")
+        elif not np.array_equal(a.view(np.uint8), b.view(np.uint8)):
+            problems.append(f"channel {name}: samples differ")
+    for p in problems:
+        print(p)
+    sys.exit(1 if problems else 0)
+
+
+if __name__ == "__main__":
+    main()
