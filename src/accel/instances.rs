@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use super::box_lanes::{BoxLanes, hits_box};
 #[cfg(target_arch = "x86_64")]
-use super::cpu::x86_fast_path;
+use super::isa::{Kernel, X86Level, dispatch};
 use super::top_level::{InstanceGrid, Mailbox};
 use super::{Grid, GridHit, Ray, TraversalStats};
 use crate::scene::{Aabb, Instance, Motion, Scene, TimeSlice};
@@ -215,20 +215,7 @@ impl SceneAccel {
                 self.ask_one_entry(ray, None, |grid, ray| grid.intersect_counting(ray, stats))?;
             return Some(self.scene_hit(0, hit, ray));
         }
-        #[cfg(target_arch = "x86_64")]
-        if x86_fast_path() {
-            // SAFETY: the processor has the features enabled there, checked just above.
-            return unsafe { self.intersect_avx2(ray, stats) };
-        }
-        self.intersect_portable(ray, stats)
-    }
-
-    /// [`SceneAccel::intersect_portable`] compiled for AVX2, where the list's box lanes are
-    /// vectors of eight (the same operations on each lane, so the same answer).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
-    fn intersect_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<SceneHit> {
-        self.intersect_portable(ray, stats)
+        dispatch(X86Level::Avx2, TopIntersect { accel: self, ray, stats })
     }
 
     #[inline(always)]
@@ -319,19 +306,7 @@ impl SceneAccel {
             stats.test_instance();
             return self.ask_one_entry(ray, false, |grid, ray| grid.occluded_counting(ray, stats));
         }
-        #[cfg(target_arch = "x86_64")]
-        if x86_fast_path() {
-            // SAFETY: the processor has the features enabled there, checked just above.
-            return unsafe { self.occluded_avx2(ray, stats) };
-        }
-        self.occluded_portable(ray, stats)
-    }
-
-    /// [`SceneAccel::occluded_portable`] compiled for AVX2, like the closest-hit query.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
-    fn occluded_avx2(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.occluded_portable(ray, stats)
+        dispatch(X86Level::Avx2, TopOccluded { accel: self, ray, stats })
     }
 
     #[inline(always)]
@@ -517,6 +492,38 @@ fn to_object(ray: &Ray, object_from_world: &Affine3A) -> Ray {
         origin: object_from_world.transform_point3(ray.origin),
         direction: object_from_world.transform_vector3(ray.direction),
         ..*ray
+    }
+}
+
+/// The top level's closest-hit query as a [`Kernel`]: compiled for AVX2, where the list's
+/// box lanes are vectors of eight (the same operations on each lane, so the same answer;
+/// AVX-512 gained nothing here).
+struct TopIntersect<'a, S> {
+    accel: &'a SceneAccel,
+    ray: &'a Ray,
+    stats: &'a mut S,
+}
+
+impl<S: TraversalStats> Kernel for TopIntersect<'_, S> {
+    type Output = Option<SceneHit>;
+    #[inline(always)]
+    fn run<const FUSED: bool>(self) -> Option<SceneHit> {
+        self.accel.intersect_portable(self.ray, self.stats)
+    }
+}
+
+/// The top level's shadow query as a [`Kernel`], like [`TopIntersect`].
+struct TopOccluded<'a, S> {
+    accel: &'a SceneAccel,
+    ray: &'a Ray,
+    stats: &'a mut S,
+}
+
+impl<S: TraversalStats> Kernel for TopOccluded<'_, S> {
+    type Output = bool;
+    #[inline(always)]
+    fn run<const FUSED: bool>(self) -> bool {
+        self.accel.occluded_portable(self.ray, self.stats)
     }
 }
 

@@ -2,7 +2,7 @@
 //! and a top level over the instances (a list, or a grid of their own when there are many).
 
 mod box_lanes;
-mod cpu;
+mod isa;
 pub mod grid;
 mod huge_pages;
 mod instances;

@@ -20,7 +20,7 @@ use mesh_triangles::MeshTriangles;
 use overlap::{Polygon, TriangleBoxTest};
 
 #[cfg(target_arch = "x86_64")]
-use crate::accel::cpu::x86_fast_path;
+use crate::accel::isa::{Kernel, X86Level, dispatch};
 use crate::accel::grid::walk::frame::{GridFrame, padded, resolution};
 use crate::accel::{Triangle, huge_pages};
 use crate::scene::Aabb;
@@ -289,26 +289,14 @@ impl Grid {
         triangles: MeshTriangles,
         boxed: bool,
     ) -> (Block, u32) {
-        #[cfg(target_arch = "x86_64")]
-        if x86_fast_path() {
-            // SAFETY: the processor has the features enabled there, checked just above.
-            return unsafe { self.block_of_avx2(run, sorted, triangles, boxed) };
-        }
-        self.block_of_portable(run, sorted, triangles, boxed)
-    }
-
-    /// [`Grid::block_of_portable`] compiled for AVX2, like the overlap tests (the
-    /// arithmetic, and so the grid, is the same).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
-    fn block_of_avx2(
-        &self,
-        run: (u32, u32, IVec3),
-        sorted: &[u32],
-        triangles: MeshTriangles,
-        boxed: bool,
-    ) -> (Block, u32) {
-        self.block_of_portable(run, sorted, triangles, boxed)
+        let work = BlockOf {
+            grid: self,
+            run,
+            sorted,
+            triangles,
+            boxed,
+        };
+        dispatch(X86Level::Avx2, work)
     }
 
     #[inline(always)]
@@ -335,21 +323,13 @@ impl Grid {
     /// The (cell, triangle) pairs of the live triangles numbered in `chunk`, in triangle
     /// order, in the buckets of `parts`.
     fn pairs_of(&self, chunk: &[u32], triangles: MeshTriangles, parts: &KeyParts) -> Buckets {
-        #[cfg(target_arch = "x86_64")]
-        if x86_fast_path() {
-            // SAFETY: the processor has the features enabled there, checked just above.
-            return unsafe { self.pairs_of_avx2(chunk, triangles, parts) };
-        }
-        self.pairs_of_portable(chunk, triangles, parts)
-    }
-
-    /// [`Grid::pairs_of_portable`] compiled for AVX2: the overlap tests' thirteen axes in
-    /// wider lanes and `floor` as one instruction (baseline x86-64 calls a library
-    /// function). The arithmetic, and so the grid, is the same.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
-    fn pairs_of_avx2(&self, chunk: &[u32], triangles: MeshTriangles, parts: &KeyParts) -> Buckets {
-        self.pairs_of_portable(chunk, triangles, parts)
+        let work = PairsOf {
+            grid: self,
+            chunk,
+            triangles,
+            parts,
+        };
+        dispatch(X86Level::Avx2, work)
     }
 
     #[inline(always)]
@@ -539,6 +519,44 @@ impl Sizes {
         self.area += other.area;
         self.perimeter += other.perimeter;
         self.count += other.count;
+    }
+}
+
+/// [`Grid::block_of_portable`] as a [`Kernel`]: compiled for AVX2 like the overlap tests
+/// (the arithmetic, and so the grid, is the same).
+struct BlockOf<'a> {
+    grid: &'a Grid,
+    run: (u32, u32, IVec3),
+    sorted: &'a [u32],
+    triangles: MeshTriangles<'a>,
+    boxed: bool,
+}
+
+impl Kernel for BlockOf<'_> {
+    type Output = (Block, u32);
+    #[inline(always)]
+    fn run<const FUSED: bool>(self) -> (Block, u32) {
+        self.grid
+            .block_of_portable(self.run, self.sorted, self.triangles, self.boxed)
+    }
+}
+
+/// [`Grid::pairs_of_portable`] as a [`Kernel`]: compiled for AVX2, the overlap tests'
+/// thirteen axes go in wider lanes and `floor` is one instruction (baseline x86-64 calls a
+/// library function). The arithmetic, and so the grid, is the same.
+struct PairsOf<'a> {
+    grid: &'a Grid,
+    chunk: &'a [u32],
+    triangles: MeshTriangles<'a>,
+    parts: &'a KeyParts,
+}
+
+impl Kernel for PairsOf<'_> {
+    type Output = Buckets;
+    #[inline(always)]
+    fn run<const FUSED: bool>(self) -> Buckets {
+        self.grid
+            .pairs_of_portable(self.chunk, self.triangles, self.parts)
     }
 }
 

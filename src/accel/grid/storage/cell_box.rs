@@ -305,7 +305,7 @@ pub(in crate::accel::grid) fn decode<const FUSED: bool>(word: u32) -> (Vec3A, Ve
             _mm_and_si128, _mm_cvtepi32_ps, _mm_set1_epi32, _mm_setr_epi32, _mm_srlv_epi32,
         };
         // SAFETY: `FUSED` code is compiled for, and runs only on, processors with AVX2 and
-        // FMA ([`crate::accel::cpu::x86_level`]), and `_mm_srlv_epi32` is AVX2.
+        // FMA ([`crate::accel::isa::x86_level`]), and `_mm_srlv_epi32` is AVX2.
         let (lo, hi) = unsafe {
             let w = _mm_set1_epi32(word as i32);
             let field = _mm_set1_epi32((1 << BITS) - 1);
@@ -470,19 +470,19 @@ mod tests {
         assert_eq!(encode(Vec3::splat(-1.0), Vec3::splat(2.0)), WHOLE);
     }
 
-    /// The AVX2 decoding where the processor has it, else the portable one.
-    fn decode_fast(word: u32) -> (Vec3A, Vec3A) {
-        #[cfg(target_arch = "x86_64")]
-        if crate::accel::cpu::x86_fast_path() {
-            // SAFETY: the processor has AVX2 and FMA, checked just above.
-            return unsafe { decode_avx2(word) };
+    /// A box word's decoding as a [`Kernel`].
+    struct Decode(u32);
+
+    impl Kernel for Decode {
+        type Output = (Vec3A, Vec3A);
+        fn run<const FUSED: bool>(self) -> (Vec3A, Vec3A) {
+            decode::<FUSED>(self.0)
         }
-        decode::<false>(word)
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn decode_avx2(word: u32) -> (Vec3A, Vec3A) {
-        decode::<true>(word)
+    /// The AVX2 decoding (with fused multiply-adds) where the processor has it, else the
+    /// portable one.
+    fn decode_fast(word: u32) -> (Vec3A, Vec3A) {
+        dispatch(X86Level::Avx2, Decode(word))
     }
 }

@@ -430,7 +430,7 @@ fn first_exit(t: Vec3A) -> (Vec3A, BVec3A) {
 /// shorter on the walk's chain of dependent operations: the warm queries of the full dragon
 /// 0.97–0.99 the time, `tools/dev/grid-ab.sh` with `GRID_AB_CHUNK=250`), else a multiply and an
 /// add. `FUSED` is set only by the grid's queries compiled with the `fma` feature, chosen
-/// at run time on processors that have it ([`crate::accel::cpu::x86_level`]); elsewhere it
+/// at run time on processors that have it ([`crate::accel::isa::x86_level`]); elsewhere it
 /// is false.
 #[inline(always)]
 fn mul_add<const FUSED: bool>(a: Vec3A, b: Vec3A, c: Vec3A) -> Vec3A {

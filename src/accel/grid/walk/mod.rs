@@ -19,8 +19,7 @@ pub use stats::{TraversalCounts, TraversalStats};
 
 use super::{Grid, GridHit};
 use crate::accel::Ray;
-#[cfg(target_arch = "x86_64")]
-use crate::accel::cpu::{X86Level, x86_level};
+use crate::accel::isa::{Kernel, X86Level, dispatch};
 
 impl Grid {
     /// The closest hit along `ray`, if any.
@@ -52,39 +51,12 @@ impl Grid {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
-        // SAFETY (each arm): the processor has the features enabled in the version called,
-        // as `x86_level` found.
-        #[cfg(target_arch = "x86_64")]
-        match x86_level() {
-            X86Level::Avx512 => return unsafe { self.intersect_avx512::<UNIT, BOXED>(ray, stats) },
-            X86Level::Avx2 => return unsafe { self.intersect_avx2::<UNIT, BOXED>(ray, stats) },
-            X86Level::Baseline => {}
-        }
-        self.intersect_portable::<false, UNIT, BOXED>(ray, stats)
-    }
-
-    /// [`Grid::intersect_portable`] compiled for AVX2, where a block's eight lanes are one
-    /// vector (the arithmetic, and so the answer, is the same).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
-    fn intersect_avx2<const UNIT: u32, const BOXED: bool>(
-        &self,
-        ray: &Ray,
-        stats: &mut impl TraversalStats,
-    ) -> Option<GridHit> {
-        self.intersect_portable::<true, UNIT, BOXED>(ray, stats)
-    }
-
-    /// [`Grid::intersect_portable`] compiled for AVX-512 ([`X86Level::Avx512`]; the same
-    /// arithmetic).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
-    fn intersect_avx512<const UNIT: u32, const BOXED: bool>(
-        &self,
-        ray: &Ray,
-        stats: &mut impl TraversalStats,
-    ) -> Option<GridHit> {
-        self.intersect_portable::<true, UNIT, BOXED>(ray, stats)
+        let query = Intersect::<_, UNIT, BOXED> {
+            grid: self,
+            ray,
+            stats,
+        };
+        dispatch(X86Level::Avx512, query)
     }
 
     #[inline(always)]
@@ -130,28 +102,12 @@ impl Grid {
     /// [`Grid::walk`] for units of 2^`UNIT` cells, as [`Grid::intersect_at`].
     #[inline(always)]
     fn walk_at<const UNIT: u32, const BOXED: bool>(&self, ray: &Ray, t_stop: f32) -> usize {
-        // SAFETY (each arm): as in `intersect_counting`.
-        #[cfg(target_arch = "x86_64")]
-        match x86_level() {
-            X86Level::Avx512 => return unsafe { self.walk_avx512::<UNIT, BOXED>(ray, t_stop) },
-            X86Level::Avx2 => return unsafe { self.walk_avx2::<UNIT, BOXED>(ray, t_stop) },
-            X86Level::Baseline => {}
-        }
-        self.walk_portable::<false, UNIT, BOXED>(ray, t_stop)
-    }
-
-    /// [`Grid::walk_portable`] compiled for AVX2, like the queries.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
-    fn walk_avx2<const UNIT: u32, const BOXED: bool>(&self, ray: &Ray, t_stop: f32) -> usize {
-        self.walk_portable::<true, UNIT, BOXED>(ray, t_stop)
-    }
-
-    /// [`Grid::walk_portable`] compiled for AVX-512, like the queries.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
-    fn walk_avx512<const UNIT: u32, const BOXED: bool>(&self, ray: &Ray, t_stop: f32) -> usize {
-        self.walk_portable::<true, UNIT, BOXED>(ray, t_stop)
+        let walk = Walk::<UNIT, BOXED> {
+            grid: self,
+            ray,
+            t_stop,
+        };
+        dispatch(X86Level::Avx512, walk)
     }
 
     #[inline(always)]
@@ -193,36 +149,12 @@ impl Grid {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> bool {
-        // SAFETY (each arm): as in `intersect_counting`.
-        #[cfg(target_arch = "x86_64")]
-        match x86_level() {
-            X86Level::Avx512 => return unsafe { self.occluded_avx512::<UNIT, BOXED>(ray, stats) },
-            X86Level::Avx2 => return unsafe { self.occluded_avx2::<UNIT, BOXED>(ray, stats) },
-            X86Level::Baseline => {}
-        }
-        self.occluded_portable::<false, UNIT, BOXED>(ray, stats)
-    }
-
-    /// [`Grid::occluded_portable`] compiled for AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
-    fn occluded_avx2<const UNIT: u32, const BOXED: bool>(
-        &self,
-        ray: &Ray,
-        stats: &mut impl TraversalStats,
-    ) -> bool {
-        self.occluded_portable::<true, UNIT, BOXED>(ray, stats)
-    }
-
-    /// [`Grid::occluded_portable`] compiled for AVX-512.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl,avx512bw,avx512dq")]
-    fn occluded_avx512<const UNIT: u32, const BOXED: bool>(
-        &self,
-        ray: &Ray,
-        stats: &mut impl TraversalStats,
-    ) -> bool {
-        self.occluded_portable::<true, UNIT, BOXED>(ray, stats)
+        let query = Occluded::<_, UNIT, BOXED> {
+            grid: self,
+            ray,
+            stats,
+        };
+        dispatch(X86Level::Avx512, query)
     }
 
     /// The cells are walked from the segment's far end back to its origin (the answer does
@@ -255,6 +187,54 @@ impl Grid {
             }
         }
         false
+    }
+}
+
+/// The closest-hit query as a [`Kernel`], compiled for each instruction set.
+struct Intersect<'a, S, const UNIT: u32, const BOXED: bool> {
+    grid: &'a Grid,
+    ray: &'a Ray,
+    stats: &'a mut S,
+}
+
+impl<S: TraversalStats, const UNIT: u32, const BOXED: bool> Kernel for Intersect<'_, S, UNIT, BOXED> {
+    type Output = Option<GridHit>;
+    #[inline(always)]
+    fn run<const FUSED: bool>(self) -> Option<GridHit> {
+        self.grid
+            .intersect_portable::<FUSED, UNIT, BOXED>(self.ray, self.stats)
+    }
+}
+
+/// The shadow query as a [`Kernel`].
+struct Occluded<'a, S, const UNIT: u32, const BOXED: bool> {
+    grid: &'a Grid,
+    ray: &'a Ray,
+    stats: &'a mut S,
+}
+
+impl<S: TraversalStats, const UNIT: u32, const BOXED: bool> Kernel for Occluded<'_, S, UNIT, BOXED> {
+    type Output = bool;
+    #[inline(always)]
+    fn run<const FUSED: bool>(self) -> bool {
+        self.grid
+            .occluded_portable::<FUSED, UNIT, BOXED>(self.ray, self.stats)
+    }
+}
+
+/// The walk alone ([`Grid::walk`]) as a [`Kernel`].
+struct Walk<'a, const UNIT: u32, const BOXED: bool> {
+    grid: &'a Grid,
+    ray: &'a Ray,
+    t_stop: f32,
+}
+
+impl<const UNIT: u32, const BOXED: bool> Kernel for Walk<'_, UNIT, BOXED> {
+    type Output = usize;
+    #[inline(always)]
+    fn run<const FUSED: bool>(self) -> usize {
+        self.grid
+            .walk_portable::<FUSED, UNIT, BOXED>(self.ray, self.t_stop)
     }
 }
 
@@ -460,22 +440,22 @@ mod tests {
             let portable = grid.intersect_portable::<false, 0, false>(&ray, &mut ());
             assert_eq!(fast, portable, "ray {k}: {ray:?}");
             // On a processor with AVX-512, the AVX2 version too.
-            #[cfg(target_arch = "x86_64")]
-            if x86_level() >= X86Level::Avx2 {
-                // SAFETY: the processor has AVX2 and the rest, as `x86_level` found.
-                let avx2 = unsafe { grid.intersect_avx2::<0, false>(&ray, &mut ()) };
-                assert_eq!(avx2, portable, "ray {k}: {ray:?}");
-            }
+            let query = Intersect::<_, 0, false> {
+                grid: &grid,
+                ray: &ray,
+                stats: &mut (),
+            };
+            assert_eq!(dispatch(X86Level::Avx2, query), portable, "ray {k}: {ray:?}");
             hits += usize::from(fast.is_some());
             ray.t_max = 1.5;
             let blocked = grid.occluded_portable::<false, 0, false>(&ray, &mut ());
             assert_eq!(grid.occluded(&ray), blocked, "ray {k}: {ray:?}");
-            #[cfg(target_arch = "x86_64")]
-            if x86_level() >= X86Level::Avx2 {
-                // SAFETY: as above.
-                let avx2 = unsafe { grid.occluded_avx2::<0, false>(&ray, &mut ()) };
-                assert_eq!(avx2, blocked, "ray {k}: {ray:?}");
-            }
+            let query = Occluded::<_, 0, false> {
+                grid: &grid,
+                ray: &ray,
+                stats: &mut (),
+            };
+            assert_eq!(dispatch(X86Level::Avx2, query), blocked, "ray {k}: {ray:?}");
         }
         assert!(hits > 5_000, "{hits} hits");
     }
