@@ -31,8 +31,8 @@ use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use gridtrace::accel::{Grid, Ray, TraversalCounts, TraversalStats};
+use gridtrace::geometry::Aabb;
 use gridtrace::load::ply;
-use gridtrace::scene::Aabb;
 use oracles::embree::Embree;
 use oracles::rays::{bounce_rays, camera_rays, light_segments, outside_rays, segments};
 use oracles::{Mesh, Obvhs, dragon_path};

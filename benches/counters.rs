@@ -16,8 +16,8 @@ mod oracles;
 use std::hint::black_box;
 
 use gridtrace::accel::{Grid, Ray};
+use gridtrace::geometry::Aabb;
 use gridtrace::load::ply;
-use gridtrace::scene::Aabb;
 use oracles::embree::Embree;
 use oracles::rays::{bounce_rays, camera_rays, light_segments, outside_rays, segments};
 use oracles::{Mesh, dragon_path};

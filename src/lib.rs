@@ -30,11 +30,9 @@
 
 pub mod accel;
 pub mod cli;
-pub mod denoise;
-pub mod display;
+pub mod geometry;
 pub mod limits;
 pub mod load;
-pub mod merge;
 pub mod output;
 pub mod record;
 pub mod render;

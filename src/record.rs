@@ -1,7 +1,7 @@
 //! What produced a rendered image: gridtrace's version, the SHA-256 of the scene and of the
 //! files it reads, the camera, size, seed and settings, and which samples of every pixel it
 //! holds. Every EXR gridtrace writes carries this record in its header, so images rendered
-//! apart — on other machines, at other times — can be checked and merged ([`crate::merge`]).
+//! apart — on other machines, at other times — can be checked and merged ([`crate::output::merge`]).
 //!
 //! The record is one text attribute, [`RECORD_ATTRIBUTE`], of `key=value` lines: the `exr`
 //! crate writes a header's attributes in hash-map order, so one attribute keeps the file's

@@ -26,8 +26,8 @@
 mod oracles;
 
 use gridtrace::accel::{Grid, Ray, SceneAccel, Triangle};
+use gridtrace::geometry::Aabb;
 use gridtrace::load::{load_scene, ply};
-use gridtrace::scene::Aabb;
 use oracles::embree::Embree;
 use oracles::rays::{bounce_rays, outside_rays, segments};
 use oracles::{DRAGON_MODELS, Mesh, Obvhs, dragon_path};

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 use gridtrace::load::load_scene;
-use gridtrace::merge::read_part;
+use gridtrace::output::merge::read_part;
 use gridtrace::render::{Image, RenderSettings, Renderer};
 use image_stats::{MAX_DEPTH, SIZE, reference, scene_path};
 

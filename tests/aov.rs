@@ -7,7 +7,7 @@ mod shapes;
 use std::path::Path;
 
 use glam::{Affine3A, Vec2, Vec3};
-use gridtrace::merge::MERGE_TOLERANCE;
+use gridtrace::output::merge::MERGE_TOLERANCE;
 use gridtrace::output::read_exr_pixels;
 use gridtrace::render::{AovSet, Image, RayGenerator, RenderSettings, Renderer};
 use gridtrace::scene::{
@@ -362,6 +362,6 @@ fn a_part_with_more_channels_than_gridtrace_writes_is_refused_before_its_pixels(
         AttributeValue::Text(Text::from(record.as_str())),
     );
     image.write().to_file(dir.path().join("wide.exr")).unwrap();
-    let err = gridtrace::merge::read_part(&dir.path().join("wide.exr")).unwrap_err();
+    let err = gridtrace::output::merge::read_part(&dir.path().join("wide.exr")).unwrap_err();
     assert!(err.to_string().contains("40 channels"), "{err}");
 }

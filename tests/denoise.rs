@@ -9,8 +9,8 @@ mod image_stats;
 use std::path::{Path, PathBuf};
 
 use glam::{DVec3, Vec3};
-use gridtrace::denoise::denoise_with_library;
 use gridtrace::load::load_scene;
+use gridtrace::output::denoise::denoise_with_library;
 use gridtrace::render::{AovSet, RenderSettings, Renderer};
 use image_stats::{MAX_DEPTH, SIZE, reference, scene_path};
 

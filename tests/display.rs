@@ -8,7 +8,7 @@ use std::net::TcpListener;
 use std::path::Path;
 use std::thread;
 
-use gridtrace::display::{CREATE_IMAGE, UPDATE_IMAGE_V3};
+use gridtrace::output::display::{CREATE_IMAGE, UPDATE_IMAGE_V3};
 use gridtrace::output::read_exr_pixels;
 
 /// A little-endian reader over one packet's fields.

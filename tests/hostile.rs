@@ -13,7 +13,7 @@ use std::process::{Command, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use gridtrace::merge::{MERGE_TOLERANCE, read_part};
+use gridtrace::output::merge::{MERGE_TOLERANCE, read_part};
 use gridtrace::output::read_exr_rgba;
 
 /// The address space every run gets.

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use gridtrace::merge::{MERGE_TOLERANCE, read_part};
+use gridtrace::output::merge::{MERGE_TOLERANCE, read_part};
 
 const TASKS: u32 = 4;
 const SPP: u32 = 256;

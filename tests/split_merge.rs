@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use binary::gridtrace;
 
 use gridtrace::load::load_scene;
-use gridtrace::merge::{MERGE_TOLERANCE, MergeError, merge_files, read_part};
+use gridtrace::output::merge::{MERGE_TOLERANCE, MergeError, merge_files, read_part};
 use gridtrace::output::{ViewTransform, write_image, write_image_with_record};
 use gridtrace::record::{RenderIdentity, RenderRecord};
 use gridtrace::render::{Image, RenderSettings, Renderer};

@@ -10,6 +10,6 @@ fuzz_target!(|data: &[u8]| {
     let _ = std::fs::create_dir_all(&dir);
     let path = dir.join("part.exr");
     if std::fs::write(&path, data).is_ok() {
-        let _ = gridtrace::merge::merge_files(&[path], None);
+        let _ = gridtrace::output::merge::merge_files(&[path], None);
     }
 });

@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use super::{Ray, SLAB_ROUNDING};
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// Boxes at most.
 pub const LANES: usize = 16;

@@ -19,7 +19,8 @@ use super::box_lanes::{BoxLanes, hits_box};
 use super::isa::{Kernel, X86Level, dispatch};
 use super::top_level::{InstanceGrid, Mailbox};
 use super::{Grid, GridHit, Ray, TraversalStats};
-use crate::scene::{Aabb, Instance, Motion, Scene, TimeSlice};
+use crate::geometry::Aabb;
+use crate::scene::{Instance, Motion, Scene, TimeSlice};
 
 /// Up to this many entries are tested one after another; past it, the instance grid
 /// visits only those near the ray (`cargo bench --bench instances`: at 11 instances the
@@ -215,7 +216,14 @@ impl SceneAccel {
                 self.ask_one_entry(ray, None, |grid, ray| grid.intersect_counting(ray, stats))?;
             return Some(self.scene_hit(0, hit, ray));
         }
-        dispatch(X86Level::Avx2, TopIntersect { accel: self, ray, stats })
+        dispatch(
+            X86Level::Avx2,
+            TopIntersect {
+                accel: self,
+                ray,
+                stats,
+            },
+        )
     }
 
     #[inline(always)]
@@ -306,7 +314,14 @@ impl SceneAccel {
             stats.test_instance();
             return self.ask_one_entry(ray, false, |grid, ray| grid.occluded_counting(ray, stats));
         }
-        dispatch(X86Level::Avx2, TopOccluded { accel: self, ray, stats })
+        dispatch(
+            X86Level::Avx2,
+            TopOccluded {
+                accel: self,
+                ray,
+                stats,
+            },
+        )
     }
 
     #[inline(always)]

@@ -2,10 +2,10 @@
 //! and a top level over the instances (a list, or a grid of their own when there are many).
 
 mod box_lanes;
-mod isa;
-pub mod grid;
+mod grid;
 mod huge_pages;
 mod instances;
+mod isa;
 mod ray;
 mod top_level;
 mod triangle;
@@ -15,5 +15,5 @@ pub use instances::{SceneAccel, SceneHit, TopLevel};
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};
 
-/// γ(3) = 3ε/(1 − 3ε) with ε = 2⁻²⁴: the relative rounding error of a slab distance.
-pub(crate) const SLAB_ROUNDING: f32 = 3.0 * f32::EPSILON * 0.5 / (1.0 - 3.0 * f32::EPSILON * 0.5);
+/// γ(3): the relative rounding error of a slab distance.
+pub(crate) const SLAB_ROUNDING: f32 = crate::geometry::gamma(3);

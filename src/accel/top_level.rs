@@ -10,7 +10,7 @@ use glam::UVec3;
 
 use super::Ray;
 use super::grid::walk::frame::{GridFrame, padded, resolution};
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// Cells per instance aimed for (λ of Cleary & Wyvill 1988). Instances are larger than
 /// triangles relative to their spacing, so fewer cells per item than the triangle grids.

@@ -4,7 +4,7 @@
 use glam::Vec3;
 
 use super::Ray;
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// A triangle stored as one vertex and two edges, the form Möller–Trumbore wants.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,10 +50,7 @@ impl Triangle {
 
     /// True when the triangle has no area or non-finite corners; such triangles are never hit.
     pub fn is_degenerate(&self) -> bool {
-        let n = self.e1.cross(self.e2);
-        let scale = self.e1.length_squared().max(self.e2.length_squared());
-        !(self.v0.is_finite() && self.e1.is_finite() && self.e2.is_finite())
-            || n.length_squared() <= 1e-14 * scale * scale
+        crate::geometry::is_degenerate(self.v0, self.e1, self.e2)
     }
 
     /// The hit with parameter in (`ray.t_min`, `t_max`), if any.

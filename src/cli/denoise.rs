@@ -6,9 +6,9 @@ use anyhow::{Context, Result};
 
 use super::args::DenoiseArgs;
 use super::signals::{Phase, check_output, write_output};
-use crate::denoise::denoise;
 use crate::limits::{check_memory, set_memory_budget};
-use crate::merge::read_part;
+use crate::output::denoise::denoise;
+use crate::output::merge::read_part;
 use crate::render::Image;
 
 /// Denoises `image` for writing, saying what guides it unless `quiet`.

@@ -155,7 +155,7 @@ mod tests {
             ..RenderSettings::default()
         };
         let camera = Camera::framing(
-            &crate::scene::Aabb::from_points([Vec3::ZERO, Vec3::ONE]),
+            &crate::geometry::Aabb::from_points([Vec3::ZERO, Vec3::ONE]),
             1.0,
         );
         let identity = render_identity(inputs, &camera, &settings);

@@ -7,9 +7,9 @@ use anyhow::Result;
 use super::args::MergeArgs;
 use super::denoise::denoise_for_output;
 use super::signals::{Phase, check_output, write_output};
-use crate::denoise::check_available;
 use crate::limits::set_memory_budget;
-use crate::merge::merge_files;
+use crate::output::denoise::check_available;
+use crate::output::merge::merge_files;
 use crate::record::format_range;
 
 /// Reads, checks and merges the parts, and writes the merged image.

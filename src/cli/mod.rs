@@ -13,7 +13,7 @@ mod inspect;
 mod merge;
 mod motion;
 mod render;
-pub mod signals;
+pub(crate) mod signals;
 mod values;
 
 pub use args::{Args, Command, DenoiseArgs, MergeArgs};

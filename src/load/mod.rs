@@ -1,11 +1,11 @@
 //! Scene loaders: each turns one file format into a [`Scene`].
 
-pub mod access;
+pub(crate) mod access;
 mod error;
 pub mod gltf;
-pub mod guard;
+pub(crate) mod guard;
 mod images;
-pub mod motion;
+pub(crate) mod motion;
 pub mod ply;
 mod polygon;
 mod subdivision;
@@ -17,7 +17,7 @@ pub use error::LoadError;
 
 use std::path::{Path, PathBuf};
 
-use crate::accel::Triangle;
+use crate::geometry::is_degenerate;
 use crate::record::Dependency;
 use crate::scene::{Environment, EnvironmentMap, Scene, blender_world_rotation};
 
@@ -130,7 +130,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Loaded, Loa
             && loaded.scene.meshes.get(instance.mesh).is_some_and(|mesh| {
                 mesh.indices.iter().all(|t| {
                     let [a, b, c] = t.map(|i| m.transform_point3(mesh.positions[i as usize]));
-                    Triangle::new(a, b, c).is_degenerate()
+                    is_degenerate(a, b - a, c - a)
                 })
             });
         if !finite || flattened {
@@ -147,7 +147,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Loaded, Loa
             let [p0, p1, p2] = [a, b, c].map(|i| mesh.positions[i as usize]);
             if !(p0.is_finite() && p1.is_finite() && p2.is_finite()) {
                 non_finite += 1;
-            } else if Triangle::new(p0, p1, p2).is_degenerate() {
+            } else if is_degenerate(p0, p1 - p0, p2 - p0) {
                 zero_area += 1;
             }
         }

@@ -1,8 +1,12 @@
-//! Writing images: OpenEXR (linear float) and PNG (8-bit sRGB through a view transform),
-//! always atomically.
+//! What a render becomes: images written atomically as OpenEXR (linear float) or PNG (8-bit
+//! sRGB through a view transform); parts of one render merged ([`merge`]); an image denoised
+//! ([`denoise`]); the image shown as it converges ([`display`]).
 
 mod agx;
+pub mod denoise;
+pub mod display;
 mod exr;
+pub mod merge;
 mod png;
 
 pub use exr::{

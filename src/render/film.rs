@@ -191,6 +191,29 @@ impl FilmRow<'_> {
 }
 
 impl Film {
+    /// A film holding sums already taken: `beauty` per pixel and, if any layer is kept,
+    /// `features` per pixel (else empty), every pixel over the same samples from
+    /// `first_sample` on. What a merge of parts resolves, with the arithmetic of a render.
+    pub fn from_sums(
+        width: u32,
+        height: u32,
+        first_sample: u32,
+        aovs: AovSet,
+        beauty: Vec<PixelAccumulator>,
+        features: Vec<FeatureAccumulator>,
+    ) -> Film {
+        Film {
+            width: width as usize,
+            height: height as usize,
+            first_sample,
+            aovs,
+            beauty,
+            features,
+            counts: Vec::new(),
+            active: Vec::new(),
+        }
+    }
+
     /// An empty film for samples from `first_sample` on, keeping the layers of `aovs`, and
     /// per-pixel counts when `adaptive`.
     pub fn new(width: u32, height: u32, first_sample: u32, aovs: AovSet, adaptive: bool) -> Film {

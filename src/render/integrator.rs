@@ -12,8 +12,9 @@ use super::aov::Features;
 use super::bsdf::Bsdf;
 use super::sampler::Sampler;
 use super::sampling::power_heuristic;
-use super::surface::{Surface, offset_ray_origin, surface_at};
+use super::surface::{Surface, surface_at};
 use crate::accel::Ray;
+use crate::geometry::offset_ray_origin;
 
 /// How direct light is estimated. Only [`Strategy::Mis`] is meant for images; the other two
 /// exist to check that all three converge to the same answer.

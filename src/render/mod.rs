@@ -3,8 +3,8 @@
 //! [`Renderer`] holds everything derived from a [`Scene`] once (acceleration structure,
 //! light list, BSDFs); [`Renderer::render`] turns a camera into an [`Image`].
 
-pub mod adaptive;
-pub mod aov;
+pub(crate) mod adaptive;
+pub(crate) mod aov;
 mod bsdf;
 mod camera;
 mod film;
@@ -23,7 +23,6 @@ pub use film::{Film, Image, PixelAccumulator};
 pub use filter::{FilterKind, PixelFilter, profile as filter_profile};
 pub use integrator::{PathResult, Strategy};
 pub use lights::{EmissiveTriangles, LightSample, LightSet};
-pub use surface::{gamma, interpolate_with_error, offset_ray_origin, transform_point_with_error};
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -52,7 +51,7 @@ pub struct RenderSettings {
     pub height: u32,
     /// Which samples of every pixel to take: `0..spp` for a whole render; a range
     /// `A..B` lets a long render be split among processes and merged (see
-    /// [`crate::merge`]).
+    /// [`crate::output::merge`]).
     pub samples: Range<u32>,
     /// Most scattering events along a path (0: emitters seen directly only).
     pub max_depth: u32,

@@ -4,6 +4,7 @@
 use glam::{Affine3A, Mat3, Vec3};
 
 use crate::accel::SceneHit;
+use crate::geometry::{interpolate_with_error, transform_point_with_error};
 use crate::scene::Scene;
 
 /// The local geometry at a ray hit, in world space.
@@ -27,57 +28,6 @@ pub struct Surface {
     pub barycentrics: Vec3,
     /// Shutter time of the path that found it: the rays it spawns see the scene then too.
     pub time: f32,
-}
-
-/// γ(n) = nε / (1 − nε), the bound on the relative error of n chained floating-point
-/// operations (Higham 2002; pbrt-v4 §6.8.1), with ε = 2⁻²⁴.
-pub fn gamma(n: i32) -> f32 {
-    let e = n as f32 * (f32::EPSILON * 0.5);
-    e / (1.0 - e)
-}
-
-/// A point transformed by `m`, and a bound on the rounding error that added.
-pub fn transform_point_with_error(m: &Affine3A, p: Vec3) -> (Vec3, Vec3) {
-    let abs = Mat3::from_cols(
-        m.matrix3.x_axis.abs().into(),
-        m.matrix3.y_axis.abs().into(),
-        m.matrix3.z_axis.abs().into(),
-    );
-    let error = gamma(3) * (abs * p.abs() + Vec3::from(m.translation).abs());
-    (m.transform_point3(p), error)
-}
-
-/// Interpolates three corners (with their error bounds) at barycentrics (b0, b1, b2), and
-/// bounds the result's error (pbrt-v4 §6.8.4: γ(7)·Σ|bᵢpᵢ|, plus the corners' own error).
-pub fn interpolate_with_error(corners: [(Vec3, Vec3); 3], b: [f32; 3]) -> (Vec3, Vec3) {
-    let mut point = Vec3::ZERO;
-    let mut error = Vec3::ZERO;
-    for ((p, e), w) in corners.into_iter().zip(b) {
-        point += w * p;
-        error += (w * p).abs() * gamma(7) + w.abs() * e;
-    }
-    (point, error)
-}
-
-/// A ray origin moved off a surface just far enough that the rounding error of `p` cannot
-/// put it on the wrong side: along the normal by the error bound projected on it, towards
-/// the side `w` leaves by, then rounded away from the surface (pbrt-v4 §6.8.6). Because the
-/// bound scales with the coordinates, this works at any scene scale, unlike a fixed epsilon.
-pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
-    let d = n.abs().dot(p_error);
-    let mut offset = d * n;
-    if w.dot(n) < 0.0 {
-        offset = -offset;
-    }
-    let mut po = p + offset;
-    for axis in 0..3 {
-        if offset[axis] > 0.0 {
-            po[axis] = po[axis].next_up();
-        } else if offset[axis] < 0.0 {
-            po[axis] = po[axis].next_down();
-        }
-    }
-    po
 }
 
 /// Per-instance data for turning object-space geometry into world space.

@@ -116,7 +116,7 @@ impl Camera {
     /// 25° above the horizon (Y up), looking at the centre with a 40° vertical field of view,
     /// far enough back that the bounding sphere fits both vertically and horizontally at
     /// `aspect`. A flat object lying or standing in any axis plane is seen at an angle.
-    pub fn framing(bounds: &crate::scene::Aabb, aspect: f32) -> Camera {
+    pub fn framing(bounds: &crate::geometry::Aabb, aspect: f32) -> Camera {
         let yfov = 40f32.to_radians();
         let (center, radius) = if bounds.is_empty() {
             (glam::Vec3::ZERO, 1.0)

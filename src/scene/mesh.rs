@@ -2,7 +2,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use super::Aabb;
+use crate::geometry::Aabb;
 
 /// An indexed triangle mesh with one material.
 #[derive(Clone, Debug, Default)]

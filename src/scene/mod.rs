@@ -22,7 +22,9 @@ pub use mesh::Mesh;
 pub use motion::{Motion, TimeSlice};
 pub use texture::{ColorSpace, Filter, Texture, TextureRef, Wrap, linear_to_srgb, srgb_to_linear};
 
-use glam::{Affine3A, Vec3};
+use glam::Affine3A;
+
+use crate::geometry::Aabb;
 
 /// One placement of a mesh in the world. Many instances may share one mesh.
 #[derive(Clone, Debug)]
@@ -38,78 +40,6 @@ pub struct Instance {
     pub motion: Option<Motion>,
     /// For one time slice of a deforming mesh: the part of the shutter it is seen in.
     pub slice: Option<TimeSlice>,
-}
-
-/// An axis-aligned bounding box.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Aabb {
-    /// Smallest corner.
-    pub min: Vec3,
-    /// Largest corner.
-    pub max: Vec3,
-}
-
-impl Aabb {
-    /// The empty box: the identity for [`Aabb::union`].
-    pub const EMPTY: Aabb = Aabb {
-        min: Vec3::INFINITY,
-        max: Vec3::NEG_INFINITY,
-    };
-
-    /// The smallest box holding all `points`.
-    pub fn from_points(points: impl IntoIterator<Item = Vec3>) -> Aabb {
-        points.into_iter().fold(Aabb::EMPTY, |b, p| b.grow(p))
-    }
-
-    /// This box grown to hold `p`.
-    pub fn grow(self, p: Vec3) -> Aabb {
-        Aabb {
-            min: self.min.min(p),
-            max: self.max.max(p),
-        }
-    }
-
-    /// The smallest box holding both.
-    pub fn union(self, other: Aabb) -> Aabb {
-        Aabb {
-            min: self.min.min(other.min),
-            max: self.max.max(other.max),
-        }
-    }
-
-    /// True when the box holds no point.
-    pub fn is_empty(&self) -> bool {
-        self.min.cmpgt(self.max).any()
-    }
-
-    /// Side lengths.
-    pub fn extent(&self) -> Vec3 {
-        self.max - self.min
-    }
-
-    /// Centre point.
-    pub fn center(&self) -> Vec3 {
-        0.5 * (self.min + self.max)
-    }
-
-    /// The eight corners.
-    pub fn corners(&self) -> [Vec3; 8] {
-        std::array::from_fn(|i| {
-            Vec3::new(
-                if i & 1 == 0 { self.min.x } else { self.max.x },
-                if i & 2 == 0 { self.min.y } else { self.max.y },
-                if i & 4 == 0 { self.min.z } else { self.max.z },
-            )
-        })
-    }
-
-    /// The bounding box of this box after an affine transform.
-    pub fn transformed(&self, m: &Affine3A) -> Aabb {
-        if self.is_empty() {
-            return *self;
-        }
-        Aabb::from_points(self.corners().map(|c| m.transform_point3(c)))
-    }
 }
 
 /// A complete scene ready to render.

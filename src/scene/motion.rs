@@ -6,7 +6,7 @@
 
 use glam::{Affine3A, Vec3A};
 
-use super::Aabb;
+use crate::geometry::Aabb;
 
 /// Transforms at `keys.len()` ≥ 2 instants spread evenly over the shutter, interpolated
 /// linearly (matrix by matrix) between neighbours.

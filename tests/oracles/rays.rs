@@ -2,9 +2,9 @@
 
 use glam::Vec3;
 use gridtrace::accel::{Ray, Triangle};
+use gridtrace::geometry::Aabb;
+use gridtrace::geometry::{interpolate_with_error, offset_ray_origin};
 use gridtrace::render::sampling::{Frame, Rng, cosine_hemisphere, uniform_triangle};
-use gridtrace::render::{interpolate_with_error, offset_ray_origin};
-use gridtrace::scene::Aabb;
 
 fn unit_vector(rng: &mut Rng) -> Vec3 {
     let z = 1.0 - 2.0 * rng.uniform();

@@ -14,16 +14,15 @@
 //! the 3D-DDA of Amanatides & Woo (1987), accepting a hit only if it lies within the
 //! current cell.
 
-pub mod build;
+mod build;
 mod storage;
 pub(crate) mod walk;
 
-pub use build::density;
 pub use walk::{TraversalCounts, TraversalStats};
 
 use glam::{UVec3, Vec3};
 
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 use storage::block::{self, Block};
 use storage::cell_box;
 use storage::cells::{CellIndex, Lookup};

@@ -10,7 +10,7 @@ use super::super::args::Args;
 use super::super::signals::{Phase, set_phase, write_output};
 use super::plan::Plan;
 use super::prepare::Prepared;
-use crate::display::LiveView;
+use crate::output::display::LiveView;
 use crate::output::{OutputError, ViewTransform};
 use crate::record::{RenderIdentity, RenderRecord};
 use crate::render::{Image, RenderStats, Renderer};

@@ -10,10 +10,10 @@ use anyhow::{Result, anyhow, bail};
 
 use super::super::args::Args;
 use super::super::signals::{arm_load_timeout, check_output};
-use crate::denoise::check_available;
 use crate::limits::set_memory_budget;
 use crate::load::LoadOptions;
 use crate::output::Format;
+use crate::output::denoise::check_available;
 use crate::render::{AovSet, DEFAULT_SPP};
 
 /// Samples per pixel of a render with a time limit and no `--spp`: as many as the time

@@ -8,7 +8,8 @@ use glam::{Vec2, Vec3};
 use super::LightSample;
 use super::sphere;
 use super::tree::{Cone, Distant, LightBounds, TreeInput};
-use crate::scene::{Aabb, LightKind};
+use crate::geometry::Aabb;
+use crate::scene::LightKind;
 
 /// Where `light` can send light from and to and how strongly, for the light tree; a
 /// directional light competes by the irradiance it brings, from its direction.

@@ -19,7 +19,7 @@
 
 use glam::{Quat, Vec3};
 
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// A cone of directions: unit `axis`, and the cosine of its half-angle (−1: every
 /// direction).

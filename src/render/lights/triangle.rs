@@ -10,9 +10,10 @@ use glam::{Affine3A, Vec2, Vec3};
 use super::LightSample;
 use super::spherical;
 use super::tree::{Cone, LightBounds, TreeInput};
+use crate::geometry::Aabb;
+use crate::geometry::{interpolate_with_error, transform_point_with_error};
 use crate::render::sampling::uniform_triangle;
-use crate::render::surface::{interpolate_with_error, transform_point_with_error};
-use crate::scene::{Aabb, ColorSpace, Motion, Scene, TextureRef, TimeSlice};
+use crate::scene::{ColorSpace, Motion, Scene, TextureRef, TimeSlice};
 
 /// One emitting triangle in world space.
 #[derive(Clone, Copy, Debug)]
@@ -124,6 +125,11 @@ impl EmissiveTriangles {
     /// Number of triangles.
     pub fn len(&self) -> usize {
         self.triangles.len()
+    }
+
+    /// True when no triangle emits.
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
     }
 
     /// Emitted power (W, mean over channels) of every triangle, in order: area ×

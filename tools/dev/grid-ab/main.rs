@@ -11,7 +11,7 @@ mod rays;
 use std::time::Instant;
 
 use gridtrace::accel::{Grid, Ray, Triangle};
-use gridtrace::scene::Aabb;
+use gridtrace::geometry::Aabb;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

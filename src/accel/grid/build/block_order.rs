@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use crate::accel::grid::build::mesh_triangles::MeshTriangles;
 use crate::accel::grid::walk::frame::GridFrame;
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// Steps per cell along each axis of the key (4 bits).
 const STEPS: f32 = 16.0;

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 use crate::accel::grid::build::mesh_triangles::MeshTriangles;
 use crate::accel::grid::walk::frame::{GridFrame, resolution};
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// λ for evenly spread triangles (the Stanford dragons of 11k and 203k triangles: 1.02–1.10×
 /// the speed of λ = 5 on outside and bounce rays, 28–32 % less memory; README, "How it

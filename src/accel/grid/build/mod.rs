@@ -3,7 +3,7 @@
 pub(in crate::accel::grid) mod block_order;
 pub(in crate::accel::grid) mod box_counts;
 pub(in crate::accel::grid) mod cell_order;
-pub mod density;
+pub(in crate::accel::grid) mod density;
 pub(in crate::accel::grid) mod mesh_triangles;
 pub(in crate::accel::grid) mod overlap;
 
@@ -19,11 +19,11 @@ use cell_order::{Buckets, CellOrder, KeyParts};
 use mesh_triangles::MeshTriangles;
 use overlap::{Polygon, TriangleBoxTest};
 
+use crate::accel::grid::walk::frame::{GridFrame, padded, resolution};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::isa::{Kernel, X86Level, dispatch};
-use crate::accel::grid::walk::frame::{GridFrame, padded, resolution};
 use crate::accel::{Triangle, huge_pages};
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// Which grids keep boxes per cell and per block ([`cell_box`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

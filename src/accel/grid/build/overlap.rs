@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// True when the triangle `v` overlaps the box with centre `center` and half-size `half`.
 ///

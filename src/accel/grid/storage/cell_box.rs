@@ -47,7 +47,7 @@ use glam::{IVec3, Vec3, Vec3A};
 use crate::accel::Triangle;
 use crate::accel::grid::storage::block::{Block, LANES};
 use crate::accel::grid::walk::frame::{CellWalk, GridFrame};
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// Grids whose blocks take more bytes than this keep a box per occupied cell: about half a
 /// large last-level cache. The 203k dragon's 23 MB of blocks gain (outside rays 0.96 the
@@ -389,6 +389,7 @@ mod tests {
     use glam::UVec3;
 
     use super::*;
+    use crate::accel::isa::{Kernel, X86Level, dispatch};
 
     /// A triangle's part within a cell holds every point of the triangle within the cell
     /// (grown by the pad), and is often smaller than the triangle's bounds clamped to the

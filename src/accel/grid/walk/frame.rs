@@ -6,7 +6,7 @@ use glam::{BVec3A, IVec3, UVec3, Vec3, Vec3A, Vec3Swizzles};
 
 use super::cell_lanes::CellLanes;
 use crate::accel::Ray;
-use crate::scene::Aabb;
+use crate::geometry::Aabb;
 
 /// Most cells along one axis.
 pub(crate) const MAX_RESOLUTION: u32 = 2048;

@@ -197,7 +197,9 @@ struct Intersect<'a, S, const UNIT: u32, const BOXED: bool> {
     stats: &'a mut S,
 }
 
-impl<S: TraversalStats, const UNIT: u32, const BOXED: bool> Kernel for Intersect<'_, S, UNIT, BOXED> {
+impl<S: TraversalStats, const UNIT: u32, const BOXED: bool> Kernel
+    for Intersect<'_, S, UNIT, BOXED>
+{
     type Output = Option<GridHit>;
     #[inline(always)]
     fn run<const FUSED: bool>(self) -> Option<GridHit> {
@@ -213,7 +215,9 @@ struct Occluded<'a, S, const UNIT: u32, const BOXED: bool> {
     stats: &'a mut S,
 }
 
-impl<S: TraversalStats, const UNIT: u32, const BOXED: bool> Kernel for Occluded<'_, S, UNIT, BOXED> {
+impl<S: TraversalStats, const UNIT: u32, const BOXED: bool> Kernel
+    for Occluded<'_, S, UNIT, BOXED>
+{
     type Output = bool;
     #[inline(always)]
     fn run<const FUSED: bool>(self) -> bool {
@@ -445,7 +449,11 @@ mod tests {
                 ray: &ray,
                 stats: &mut (),
             };
-            assert_eq!(dispatch(X86Level::Avx2, query), portable, "ray {k}: {ray:?}");
+            assert_eq!(
+                dispatch(X86Level::Avx2, query),
+                portable,
+                "ray {k}: {ray:?}"
+            );
             hits += usize::from(fast.is_some());
             ray.t_max = 1.5;
             let blocked = grid.occluded_portable::<false, 0, false>(&ray, &mut ());

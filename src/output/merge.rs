@@ -20,7 +20,7 @@ use crate::limits::check_memory;
 use crate::output::{read_exr_header, read_exr_pixels};
 use crate::record::{RECORD_ATTRIBUTE, RecordError, RenderRecord, format_range};
 use crate::render::aov::FeatureAccumulator;
-use crate::render::{AovImage, Image, PixelAccumulator};
+use crate::render::{AovImage, Film, Image, PixelAccumulator};
 
 /// Largest relative difference between a merged pixel and the single render's: 2^-22.
 pub const MERGE_TOLERANCE: f32 = 1.0 / (1u32 << 22) as f32;
@@ -399,17 +399,15 @@ pub fn merge_parts(
             }
         }
     }
-    let spp = have.end - have.start;
-    let mut image = Image::new(identity.width, identity.height);
-    image.spp = spp;
-    image.first_sample = have.start;
-    image.aovs = AovImage::with_layers(layers.unwrap_or_default(), n);
-    for (i, acc) in pixels.iter().enumerate() {
-        (image.pixels[i], image.alpha[i]) = acc.resolve(spp);
-        if let Some(f) = features.get(i) {
-            image.aovs.set_pixel(i, &f.resolve(spp, acc.sum()));
-        }
-    }
+    let film = Film::from_sums(
+        width,
+        height,
+        have.start,
+        layers.unwrap_or_default(),
+        pixels,
+        features,
+    );
+    let (image, _) = film.resolve(have.end - have.start);
     let record = RenderRecord {
         identity: identity.clone(),
         scene_name: first.record.scene_name.clone(),

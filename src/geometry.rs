@@ -1,0 +1,137 @@
+//! The geometry every layer shares: axis-aligned boxes, the bounds on floating-point
+//! rounding error (Higham 2002; pbrt-v4 §6.8) that let rays leave surfaces and cross slabs
+//! without an epsilon, and which triangles are too degenerate ever to be hit.
+
+use glam::{Affine3A, Mat3, Vec3};
+
+/// An axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: Vec3,
+    /// Largest corner.
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box: the identity for [`Aabb::union`].
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::INFINITY,
+        max: Vec3::NEG_INFINITY,
+    };
+
+    /// The smallest box holding all `points`.
+    pub fn from_points(points: impl IntoIterator<Item = Vec3>) -> Aabb {
+        points.into_iter().fold(Aabb::EMPTY, |b, p| b.grow(p))
+    }
+
+    /// This box grown to hold `p`.
+    pub fn grow(self, p: Vec3) -> Aabb {
+        Aabb {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    /// The smallest box holding both.
+    pub fn union(self, other: Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    /// True when the box holds no point.
+    pub fn is_empty(&self) -> bool {
+        self.min.cmpgt(self.max).any()
+    }
+
+    /// Side lengths.
+    pub fn extent(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    /// Centre point.
+    pub fn center(&self) -> Vec3 {
+        0.5 * (self.min + self.max)
+    }
+
+    /// The eight corners.
+    pub fn corners(&self) -> [Vec3; 8] {
+        std::array::from_fn(|i| {
+            Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            )
+        })
+    }
+
+    /// The bounding box of this box after an affine transform.
+    pub fn transformed(&self, m: &Affine3A) -> Aabb {
+        if self.is_empty() {
+            return *self;
+        }
+        Aabb::from_points(self.corners().map(|c| m.transform_point3(c)))
+    }
+}
+
+/// γ(n) = nε / (1 − nε), the bound on the relative error of n chained floating-point
+/// operations (Higham 2002; pbrt-v4 §6.8.1), with ε = 2⁻²⁴.
+pub const fn gamma(n: i32) -> f32 {
+    let e = n as f32 * (f32::EPSILON * 0.5);
+    e / (1.0 - e)
+}
+
+/// A point transformed by `m`, and a bound on the rounding error that added.
+pub fn transform_point_with_error(m: &Affine3A, p: Vec3) -> (Vec3, Vec3) {
+    let abs = Mat3::from_cols(
+        m.matrix3.x_axis.abs().into(),
+        m.matrix3.y_axis.abs().into(),
+        m.matrix3.z_axis.abs().into(),
+    );
+    let error = gamma(3) * (abs * p.abs() + Vec3::from(m.translation).abs());
+    (m.transform_point3(p), error)
+}
+
+/// Interpolates three corners (with their error bounds) at barycentrics (b0, b1, b2), and
+/// bounds the result's error (pbrt-v4 §6.8.4: γ(7)·Σ|bᵢpᵢ|, plus the corners' own error).
+pub fn interpolate_with_error(corners: [(Vec3, Vec3); 3], b: [f32; 3]) -> (Vec3, Vec3) {
+    let mut point = Vec3::ZERO;
+    let mut error = Vec3::ZERO;
+    for ((p, e), w) in corners.into_iter().zip(b) {
+        point += w * p;
+        error += (w * p).abs() * gamma(7) + w.abs() * e;
+    }
+    (point, error)
+}
+
+/// A ray origin moved off a surface just far enough that the rounding error of `p` cannot
+/// put it on the wrong side: along the normal by the error bound projected on it, towards
+/// the side `w` leaves by, then rounded away from the surface (pbrt-v4 §6.8.6). Because the
+/// bound scales with the coordinates, this works at any scene scale, unlike a fixed epsilon.
+pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
+    let d = n.abs().dot(p_error);
+    let mut offset = d * n;
+    if w.dot(n) < 0.0 {
+        offset = -offset;
+    }
+    let mut po = p + offset;
+    for axis in 0..3 {
+        if offset[axis] > 0.0 {
+            po[axis] = po[axis].next_up();
+        } else if offset[axis] < 0.0 {
+            po[axis] = po[axis].next_down();
+        }
+    }
+    po
+}
+
+/// True when the triangle (`v0`, `v0 + e1`, `v0 + e2`) has no area or non-finite corners;
+/// such triangles are never hit, so loaders warn about them and grids leave them out.
+pub fn is_degenerate(v0: Vec3, e1: Vec3, e2: Vec3) -> bool {
+    let n = e1.cross(e2);
+    let scale = e1.length_squared().max(e2.length_squared());
+    !(v0.is_finite() && e1.is_finite() && e2.is_finite())
+        || n.length_squared() <= 1e-14 * scale * scale
+}
