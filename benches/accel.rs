@@ -24,7 +24,7 @@
 //! middle one and the full dragon), `ACCEL_BENCH_RAYS` (rays per set, default 100,000),
 //! `ACCEL_BENCH_RUNS` (default 5), `ACCEL_BENCH_DENSITY` (the grid's cells per triangle).
 
-#[path = "../tests/oracles/mod.rs"]
+#[path = "../tests/support/oracles/mod.rs"]
 mod oracles;
 
 use std::ops::Range;

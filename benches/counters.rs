@@ -10,7 +10,7 @@
 //! `COUNTERS_SET` (`outside`, `camera`, `bounce`, `shadow` or `light`), `COUNTERS_RAYS` (default
 //! 10,000).
 
-#[path = "../tests/oracles/mod.rs"]
+#[path = "../tests/support/oracles/mod.rs"]
 mod oracles;
 
 use std::hint::black_box;

@@ -3,10 +3,10 @@
 //! instance in turn (the list, as the renderer did before the grid), in one run.
 //!
 //! Run with `cargo bench --bench instances`. Single thread (the counts, not the cores, are
-//! the question). Scenes: `tests/instances` — copies of a 288-triangle sphere over a ground,
+//! the question). Scenes: `tests/support/instances` — copies of a 288-triangle sphere over a ground,
 //! one of them moving, under a constant sky.
 
-#[path = "../tests/instances/mod.rs"]
+#[path = "../tests/support/instances/mod.rs"]
 mod instances;
 
 use std::time::{Duration, Instant};

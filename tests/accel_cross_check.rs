@@ -23,6 +23,7 @@
 //!   triangle (bounce rays whose hit lies very close to their origin). The grid and Embree
 //!   are right.
 
+#[path = "support/oracles/mod.rs"]
 mod oracles;
 
 use gridtrace::accel::{Grid, Ray, SceneAccel, Triangle};

@@ -2,7 +2,9 @@
 //! budget on the bundled spheres scene, stays deterministic across thread counts, and a
 //! time-limited render says how many samples it holds.
 
+#[path = "support/binary/mod.rs"]
 mod binary;
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
 
 use std::time::Instant;

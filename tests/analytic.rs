@@ -2,7 +2,9 @@
 //! mirror, a glass slab, and a closed enclosure in radiative equilibrium that no object may
 //! disturb. Each is checked for all three direct-light strategies where they differ.
 
+#[path = "support/estimates/mod.rs"]
 mod estimates;
+#[path = "support/shapes/mod.rs"]
 mod shapes;
 
 use estimates::{assert_matches, estimate};

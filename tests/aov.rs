@@ -1,7 +1,9 @@
 //! Auxiliary layers: albedo, normal and depth against what the scene says analytically,
 //! directly and through a mirror; and layers of split renders merging like the beauty.
 
+#[path = "support/binary/mod.rs"]
 mod binary;
+#[path = "support/shapes/mod.rs"]
 mod shapes;
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! Every file in the corpus `tests/bad/` (made by `tools/dev/make_bad_inputs.py`) gives its
+//! Every file in the corpus `tests/data/bad/` (made by `tools/dev/make_bad_inputs.py`) gives its
 //! exact outcome: a one-line error naming the file and the problem with exit code 2, or a
 //! warning naming it and a rendered image. Nothing panics, hangs or writes a partial image.
 
@@ -141,12 +141,12 @@ fn run(scene: &Path, out: &Path) -> (Option<i32>, String) {
 
 #[test]
 fn every_bad_input_has_its_exact_outcome() {
-    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad");
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad");
     let on_disk = std::fs::read_dir(&corpus).unwrap().count();
     assert_eq!(
         on_disk,
         CASES.len(),
-        "every file in tests/bad has a case here, and every case a file"
+        "every file in tests/data/bad has a case here, and every case a file"
     );
     let dir = tempfile::tempdir().unwrap();
     for (name, expect) in CASES {

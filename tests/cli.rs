@@ -1,6 +1,8 @@
 //! The `gridtrace` command as a user runs it.
 
+#[path = "support/binary/mod.rs"]
 mod binary;
+#[path = "support/common/mod.rs"]
 mod common;
 
 use std::path::Path;
@@ -308,7 +310,7 @@ fn ctrl_c_stops_after_the_current_pass_and_writes_the_image_so_far() {
 #[test]
 fn inspect_lists_what_was_loaded_and_renders_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/punctual_lights.glb");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/scenes/punctual_lights.glb");
     let out = gridtrace(&["--inspect", &scene.display().to_string()], dir.path());
     assert!(out.status.success(), "{}", stderr(&out));
     let report = String::from_utf8_lossy(&out.stdout);

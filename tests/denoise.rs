@@ -4,6 +4,7 @@
 //! Needs the OIDN 2 library (`tools/user/install-oidn.sh`, which the test command runs, puts it
 //! in `.oidn/lib`); without it the test says so and passes.
 
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
 
 use std::path::{Path, PathBuf};

@@ -3,6 +3,7 @@
 //! of confusion, A·|z − s| / (z·s) on the image plane at unit distance (A the aperture
 //! radius, s the focus distance, z the point's depth), with its energy kept.
 
+#[path = "support/shapes/mod.rs"]
 mod shapes;
 
 use glam::{Affine3A, Vec3};

@@ -1,6 +1,7 @@
 //! The live view: a fake tev server decodes what `--display` sends (tev's IPC protocol) and
 //! finds the image gridtrace wrote; a viewer that goes away does not stop the render.
 
+#[path = "support/binary/mod.rs"]
 mod binary;
 
 use std::io::Read;

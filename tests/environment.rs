@@ -2,7 +2,9 @@
 //! integral of the map, light-only, BSDF-only and MIS agree, and MIS beats both single
 //! strategies on a map with a sun in it.
 
+#[path = "support/estimates/mod.rs"]
 mod estimates;
+#[path = "support/shapes/mod.rs"]
 mod shapes;
 
 use glam::{DVec3, Vec2, Vec3};

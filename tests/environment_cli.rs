@@ -3,6 +3,7 @@
 //! `--environment-strength` scales it, `--environment-rotation` turns it, and
 //! `--hide-environment` keeps its light but shows the camera black, alpha 0.
 
+#[path = "support/binary/mod.rs"]
 mod binary;
 
 use std::path::{Path, PathBuf};
@@ -11,7 +12,7 @@ use binary::{gridtrace, stderr};
 
 fn scene(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/scenes")
+        .join("tests/data/scenes")
         .join(name)
         .display()
         .to_string()

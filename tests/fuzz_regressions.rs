@@ -1,5 +1,5 @@
 //! Inputs the fuzzers (`fuzz/`, run with `cargo fuzz`) found crashing, kept so they stay
-//! fixed: each file under `tests/fuzz_crashes/<target>/` goes through the same code as its
+//! fixed: each file under `tests/data/fuzz_crashes/<target>/` goes through the same code as its
 //! fuzz target and must come back as an error or a result, never a panic.
 
 use std::path::Path;
@@ -8,7 +8,7 @@ use gridtrace::load::{gltf, ply};
 
 fn inputs(target: &str) -> Vec<(String, Vec<u8>)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fuzz_crashes")
+        .join("tests/data/fuzz_crashes")
         .join(target);
     let mut files: Vec<_> = std::fs::read_dir(dir)
         .map(|d| d.flatten().map(|e| e.path()).collect())
@@ -59,7 +59,7 @@ fn ply_crashers_are_errors() {
 /// a process): the loader reads them in a child process first, so they come back as errors.
 #[test]
 fn usd_crashers_are_errors() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_crashes/usd");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz_crashes/usd");
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
         .flatten()

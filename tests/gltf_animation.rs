@@ -7,7 +7,9 @@
 //! one of Blender's (both ways), and at frame 13 renders agreeing within their noise (the
 //! reference-image criteria).
 
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
+#[path = "support/world/mod.rs"]
 mod world;
 
 use std::path::{Path, PathBuf};
@@ -22,7 +24,7 @@ use world::{corners, farthest, world_triangles};
 const FRAMES: [u32; 4] = [1, 7, 13, 24];
 
 fn scene_file(name: &str) -> PathBuf {
-    Path::new("tests/scenes/gltf_animation").join(name)
+    Path::new("tests/data/scenes/gltf_animation").join(name)
 }
 
 fn load_at(path: &Path, frame: Option<f64>, animation: Option<&str>) -> (Scene, Vec<String>) {

@@ -3,8 +3,11 @@
 //! `EXT_mesh_gpu_instancing`, `KHR_materials_unlit` and
 //! `KHR_materials_pbrSpecularGlossiness`.
 
+#[path = "support/binary/mod.rs"]
 mod binary;
+#[path = "support/common/mod.rs"]
 mod common;
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
 
 use std::path::{Path, PathBuf};

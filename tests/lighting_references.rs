@@ -5,6 +5,7 @@
 //! the criteria of the other references (image means within 2 %, 8×8 blocks within 5
 //! standard errors, rms z under 1.3).
 
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
 
 use std::path::Path;
@@ -21,7 +22,7 @@ const SPP: u32 = 1024;
 const SKY: Vec3 = Vec3::new(0.3, 0.45, 0.7);
 
 fn scene(file: &str) -> Scene {
-    let loaded = load_scene(&Path::new("tests/scenes").join(file)).unwrap();
+    let loaded = load_scene(&Path::new("tests/data/scenes").join(file)).unwrap();
     assert!(loaded.warnings.is_empty(), "{file}: {:?}", loaded.warnings);
     loaded.scene
 }
@@ -51,7 +52,7 @@ fn hdr_world_from_usd_matches_cycles() {
 #[test]
 fn hdr_world_given_to_gltf_matches_cycles() {
     let mut scene = scene("lighting_hdr.glb");
-    let sky = load_environment(Path::new("tests/scenes/textures/lighting_sky.hdr")).unwrap();
+    let sky = load_environment(Path::new("tests/data/scenes/textures/lighting_sky.hdr")).unwrap();
     scene.environment = Some(sky);
     check("lighting_hdr", "lighting_hdr.glb + --environment", &scene);
 }

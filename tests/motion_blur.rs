@@ -7,6 +7,7 @@
 //! camera moving the other way. Limits were fixed before looking: 6 standard errors on
 //! every column mean, 1 % on energy.
 
+#[path = "support/binary/mod.rs"]
 mod binary;
 
 use std::path::Path;

@@ -3,6 +3,7 @@
 //! `--filter blackman-harris` within the criteria of every reference, and does so at the
 //! edges better than gridtrace's one-pixel box does (the figures are printed).
 
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
 
 use gridtrace::load::load_scene;

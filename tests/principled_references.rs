@@ -3,6 +3,7 @@
 //! exporters, compared with the same criteria as the ideal-material references (image means
 //! within 2 %, 8×8 blocks within 5 standard errors, rms z under 1.3).
 
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
 
 use std::path::Path;
@@ -13,7 +14,7 @@ use image_stats::{check_agreement, reference, render_halves};
 const SPP: u32 = 1024;
 
 fn check(name: &str, extension: &str, spp: u32) {
-    let path = Path::new("tests/scenes").join(format!("{name}.{extension}"));
+    let path = Path::new("tests/data/scenes").join(format!("{name}.{extension}"));
     let ours = render_halves(&path, spp, 1);
     check_agreement(
         &format!("{name}.{extension} at {spp} spp vs Cycles"),

@@ -2,6 +2,7 @@
 //! Cycles (`tools/blender/make_references.py`, materials replaced by exactly our models) and
 //! by gridtrace, and the two must agree within their measured noise (`image_stats`).
 
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
 
 use gridtrace::load::load_scene;

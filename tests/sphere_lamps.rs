@@ -4,7 +4,9 @@
 //! π·L·(r/d)²·cos α; a spot cone scales that by its falloff seen from the centre. Every
 //! direct-light strategy must agree, and camera rays pass a lamp the camera does not see.
 
+#[path = "support/estimates/mod.rs"]
 mod estimates;
+#[path = "support/shapes/mod.rs"]
 mod shapes;
 
 use glam::Vec3;

@@ -2,7 +2,9 @@
 //! the stated f32 rounding bound; sets of parts that do not make one render are refused
 //! with messages that name the files.
 
+#[path = "support/binary/mod.rs"]
 mod binary;
+#[path = "support/common/mod.rs"]
 mod common;
 
 use std::ops::Range;

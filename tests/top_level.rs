@@ -2,6 +2,7 @@
 //! must find exactly what testing every instance in turn finds, and whose work per ray must
 //! grow far slower than the instance count.
 
+#[path = "support/instances/mod.rs"]
 mod instances;
 
 use gridtrace::accel::{SceneAccel, TopLevel, TraversalCounts};

@@ -1,6 +1,7 @@
 //! USD animation: time-sampled transforms, points, cameras and lights read at `--frame`,
 //! on a hand-written stage and on Blender's animation export.
 
+#[path = "support/world/mod.rs"]
 mod world;
 
 use std::path::Path;
@@ -131,7 +132,7 @@ fn animated_stages_are_read_at_the_frame_asked_for() {
 /// sample per frame over 1–11. Read at the first, middle and last frame.
 #[test]
 fn blender_animation_is_read_at_each_frame() {
-    let path = Path::new("tests/scenes/animated.usdc");
+    let path = Path::new("tests/data/scenes/animated.usdc");
     let at = |frame| scene_at_frame(path, frame);
     let cube_centre = |scene: &Scene| {
         let inst = scene

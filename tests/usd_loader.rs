@@ -1,7 +1,9 @@
 //! The USD loader: Blender's USD export renders like its glTF export, and a hand-written
 //! stage exercises transforms, units, axes, topology, materials, cameras and lights.
 
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
+#[path = "support/world/mod.rs"]
 mod world;
 
 use std::path::Path;
@@ -26,8 +28,8 @@ fn blender_cornell_box_from_usdc_renders_like_the_glb() {
 /// intensities (W/π for points and spots, W/4 for the sun) must give the glTF ones' image.
 #[test]
 fn blender_lights_from_usdc_render_like_the_glb() {
-    let usd = render_halves(Path::new("tests/scenes/punctual_lights.usdc"), 256, 11);
-    let gltf = render_halves(Path::new("tests/scenes/punctual_lights.glb"), 256, 21);
+    let usd = render_halves(Path::new("tests/data/scenes/punctual_lights.usdc"), 256, 11);
+    let gltf = render_halves(Path::new("tests/data/scenes/punctual_lights.glb"), 256, 21);
     check_agreement("punctual_lights.usdc vs punctual_lights.glb", &usd, &gltf);
 }
 
@@ -37,8 +39,8 @@ fn blender_lights_from_usdc_render_like_the_glb() {
 /// switched from its nearest sampler to bilinear to compare like with like.
 #[test]
 fn blender_textures_from_usdc_render_like_the_glb() {
-    let usd = render_halves(Path::new("tests/scenes/textured.usdc"), 256, 11);
-    let mut gltf = load_scene(Path::new("tests/scenes/textured.glb"))
+    let usd = render_halves(Path::new("tests/data/scenes/textured.usdc"), 256, 11);
+    let mut gltf = load_scene(Path::new("tests/data/scenes/textured.glb"))
         .unwrap()
         .scene;
     for m in &mut gltf.materials {
@@ -616,7 +618,7 @@ fn broken_usd_files_give_one_clear_error() {
 /// The same Blender export packaged as `.usdz` loads the same scene.
 #[test]
 fn usdz_packages_load_like_their_usdc() {
-    let usdz = load_scene(Path::new("tests/scenes/cornell_box.usdz")).unwrap();
+    let usdz = load_scene(Path::new("tests/data/scenes/cornell_box.usdz")).unwrap();
     let usdc = load_scene(Path::new("assets/cornell_box.usdc")).unwrap();
     assert!(usdz.warnings.is_empty(), "{:?}", usdz.warnings);
     assert_eq!(

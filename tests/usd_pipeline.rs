@@ -1,8 +1,10 @@
 //! USD as studios and Apple's tools write it, checked against the answers Pixar's own
 //! library computes for the same stages (`tools/dev/make_usd_pipeline.py` writes both: the
-//! stages under `tests/scenes/usd_pipeline/` and a JSON file of answers beside each).
+//! stages under `tests/data/scenes/usd_pipeline/` and a JSON file of answers beside each).
 
+#[path = "support/image_stats/mod.rs"]
 mod image_stats;
+#[path = "support/world/mod.rs"]
 mod world;
 
 use std::collections::BTreeSet;
@@ -14,7 +16,7 @@ use image_stats::{check_agreement, render_halves};
 use serde_json::Value;
 use world::{farthest, mesh_points};
 
-const DIR: &str = "tests/scenes/usd_pipeline";
+const DIR: &str = "tests/data/scenes/usd_pipeline";
 
 fn answers(name: &str) -> Value {
     let text = std::fs::read_to_string(Path::new(DIR).join(name)).unwrap();
@@ -342,8 +344,8 @@ fn implicit_prims_fill_the_bounds_usd_computes() {
 /// (whose render is compared with Cycles in `principled_references`).
 #[test]
 fn blender_glass_from_usd_with_materialx_is_the_gltf_glass() {
-    let usd = load_scene(Path::new("tests/scenes/principled_glass.usdc")).unwrap();
-    let gltf = load_scene(Path::new("tests/scenes/principled_glass.glb")).unwrap();
+    let usd = load_scene(Path::new("tests/data/scenes/principled_glass.usdc")).unwrap();
+    let gltf = load_scene(Path::new("tests/data/scenes/principled_glass.glb")).unwrap();
     let find = |scene: &Scene| {
         scene
             .materials

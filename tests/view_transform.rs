@@ -3,6 +3,7 @@
 //! AgX view (`tools/blender/make_view_transform_ramp.py`) and formed by gridtrace from the
 //! same EXR must agree within 1/255 on average (the limit, fixed before looking).
 
+#[path = "support/binary/mod.rs"]
 mod binary;
 
 use std::path::Path;
@@ -12,7 +13,7 @@ use gridtrace::output::{ViewTransform, display_bytes, read_exr_rgba};
 use gridtrace::render::Image;
 
 fn ramp() -> Image {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/references/view_ramp.exr");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/references/view_ramp.exr");
     let header = gridtrace::output::read_exr_header(&path).unwrap();
     let (pixels, alpha) = read_exr_rgba(&path).unwrap();
     let mut image = Image::new(header.width as u32, header.height as u32);
@@ -22,7 +23,7 @@ fn ramp() -> Image {
 }
 
 fn blender_agx() -> Vec<u8> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/references/view_ramp_agx.png");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/references/view_ramp_agx.png");
     image::open(path).unwrap().to_rgb8().into_raw()
 }
 

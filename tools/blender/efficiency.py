@@ -10,7 +10,7 @@ For each reference scene of make_references.py (128x128, box filter, 64 bounces,
 world, materials replaced by gridtrace's models), both renderers render it at each sample
 count in this one run, on the same cores (Cycles: CPU, threads auto; gridtrace: one thread
 per core). Error is the mean squared error against the reference's mean (the two halves in
-tests/references), less the reference's own noise (the halves' squared difference / 4);
+tests/data/references), less the reference's own noise (the halves' squared difference / 4);
 time is the time spent sampling: gridtrace's reported render time (loading excluded), and
 for Cycles the time of the N-sample render less that of a 1-sample render (scene sync and
 BVH build), scaled by N / (N - 1). Efficiency is 1 / (MSE x time); the table gives both

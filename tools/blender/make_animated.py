@@ -5,7 +5,7 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
     pip install bpy==5.0.1
     python3 tools/blender/make_animated.py
 
-Writes `tests/scenes/animated.usdc`: over frames 1–11 (linear keys), a cube slides 2 m
+Writes `tests/data/scenes/animated.usdc`: over frames 1–11 (linear keys), a cube slides 2 m
 along Blender's +X, the camera's focal length goes from 50 mm to 25 mm and a point light's
 power from 100 W to 300 W, under a still emissive panel. Blender's USD exporter writes
 every animated attribute as time samples, one per frame; `tests/usd_loader.rs` reads it at
@@ -17,7 +17,7 @@ import os
 import bpy
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-OUT = os.path.join(ROOT, "tests", "scenes", "animated.usdc")
+OUT = os.path.join(ROOT, "tests", "data", "scenes", "animated.usdc")
 
 
 def animate(data_block, prop, first, last):

@@ -6,7 +6,7 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
     python3 tools/blender/make_cornell.py
 
 Writes `assets/cornell_box.glb` (two diffuse boxes, also as `assets/cornell_box.usdc` and
-`tests/scenes/cornell_box.usdz` through Blender's USD exporter) and `assets/cornell_spheres.glb` (a mirror sphere and a glass sphere). Blender is Z-up; the exporter converts to glTF's Y-up.
+`tests/data/scenes/cornell_box.usdz` through Blender's USD exporter) and `assets/cornell_spheres.glb` (a mirror sphere and a glass sphere). Blender is Z-up; the exporter converts to glTF's Y-up.
 The wall colours are the usual Cornell box reflectances; the light is an emissive quad that
 fills an opening in the ceiling, exported through KHR_materials_emissive_strength.
 """
@@ -19,7 +19,7 @@ import bpy
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ASSETS = os.path.join(ROOT, "assets")
-TEST_SCENES = os.path.join(ROOT, "tests", "scenes")
+TEST_SCENES = os.path.join(ROOT, "tests", "data", "scenes")
 
 WHITE = (0.725, 0.71, 0.68)
 RED = (0.63, 0.065, 0.05)

@@ -29,7 +29,7 @@ DIFFERENCE_SCALE = 4.0
 
 def scene_path(name):
     asset = os.path.join(ROOT, "assets", f"{name}.glb")
-    return asset if os.path.exists(asset) else os.path.join(ROOT, "tests", "scenes", f"{name}.glb")
+    return asset if os.path.exists(asset) else os.path.join(ROOT, "tests", "data", "scenes", f"{name}.glb")
 
 
 def read_exr(path):
@@ -71,7 +71,7 @@ def main():
             subprocess.run([binary, scene_path(name), "-o", out, "--width", str(SIZE), "--height", str(SIZE),
                             "--spp", "512", "--max-depth", "64", "-q"], check=True)
             ours = read_exr(out)
-            refs = [read_exr(os.path.join(ROOT, "tests", "references", f"{name}_{h}.exr")) for h in "ab"]
+            refs = [read_exr(os.path.join(ROOT, "tests", "data", "references", f"{name}_{h}.exr")) for h in "ab"]
             reference = 0.5 * (refs[0] + refs[1])
             difference = np.abs(ours - reference) * DIFFERENCE_SCALE
             rows.append([reference, ours, difference])

@@ -8,7 +8,7 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
 
 The scene is make_references.py's `cornell_box` (its glTF is `assets/cornell_box.glb`, not
 rewritten here), with the same exact material models and unbiased settings; only the filter
-differs. Writes `tests/references/cornell_box_blackman_harris_{a,b}.exr`.
+differs. Writes `tests/data/references/cornell_box_blackman_harris_{a,b}.exr`.
 """
 
 import argparse

@@ -6,7 +6,7 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
     pip install bpy==5.0.1
     python3 tools/blender/make_gltf_animation.py
 
-Writes `tests/scenes/gltf_animation/animated.glb` and, for frames 1, 7, 13 and 24,
+Writes `tests/data/scenes/gltf_animation/animated.glb` and, for frames 1, 7, 13 and 24,
 `frame_F.glb`. Over frames 1–24 (Bezier keys, which the exporter bakes one sample per
 frame):
 
@@ -29,7 +29,7 @@ import os
 import bpy
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-OUT = os.path.join(ROOT, "tests", "scenes", "gltf_animation")
+OUT = os.path.join(ROOT, "tests", "data", "scenes", "gltf_animation")
 FRAMES = [1, 7, 13, 24]
 
 

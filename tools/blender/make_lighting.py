@@ -11,7 +11,7 @@ renderers: these scenes test the light, see `matte`); Cycles runs with make_refe
 unbiased settings, but keeps the world.
 
 - lighting_hdr: a floor and three spheres under an Environment Texture world whose
-  latitude-longitude image, `tests/scenes/textures/lighting_sky.hdr`, this script computes
+  latitude-longitude image, `tests/data/scenes/textures/lighting_sky.hdr`, this script computes
   (a sky gradient, a red patch on the horizon, a small sun). `.glb` (no world: gridtrace
   renders it with `--environment` on the same .hdr) and `.usdc` (a DomeLight).
 - lighting_sun_sky: the same objects under a sun lamp (angle 0) and a constant sky-coloured

@@ -6,8 +6,8 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
     pip install bpy==5.0.1
     python3 tools/blender/make_principled.py [--samples N] [--only NAME]
 
-For every scene this writes `tests/scenes/<name>.glb` and `.usdc` through Blender's own
-exporters, and two Cycles renders with different seeds, `tests/references/<name>_a.exr` and
+For every scene this writes `tests/data/scenes/<name>.glb` and `.usdc` through Blender's own
+exporters, and two Cycles renders with different seeds, `tests/data/references/<name>_a.exr` and
 `_b.exr` (see make_references.py, whose unbiased Cycles settings it shares: box filter, no
 clamping, no denoising, 64 bounces, black world).
 

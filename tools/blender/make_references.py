@@ -6,8 +6,8 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
     python3 tools/blender/make_references.py [--samples N] [--only NAME]
 
 For every scene this writes the glTF file gridtrace renders (the bundled Cornell scenes stay in
-`assets/`, the others go to `tests/scenes/`) and two Cycles renders with different seeds,
-`tests/references/<name>_a.exr` and `_b.exr`, each with half the samples. Their mean is the
+`assets/`, the others go to `tests/data/scenes/`) and two Cycles renders with different seeds,
+`tests/data/references/<name>_a.exr` and `_b.exr`, each with half the samples. Their mean is the
 reference; their difference measures the reference's own noise (tests/reference_images.rs).
 
 Before rendering, every Principled BSDF is replaced by the node that is gridtrace's model of it:
@@ -35,8 +35,8 @@ from make_cornell import (  # noqa: E402
 )
 
 ROOT = make_cornell.ROOT
-SCENES = os.path.join(ROOT, "tests", "scenes")
-REFERENCES = os.path.join(ROOT, "tests", "references")
+SCENES = os.path.join(ROOT, "tests", "data", "scenes")
+REFERENCES = os.path.join(ROOT, "tests", "data", "references")
 SIZE = 128
 
 

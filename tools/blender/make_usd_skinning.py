@@ -3,7 +3,7 @@ a two-bone armature, exported once with its skeleton and animation (UsdSkel), an
 checked frame as the mesh Blender itself deforms (armature applied, no skeleton). gridtrace
 skins the first at `--frame F`; `tests/usd_pipeline.rs` compares with the second.
 
-    /tmp/bpyenv/bin/python tools/blender/make_usd_skinning.py tests/scenes/usd_pipeline
+    /tmp/bpyenv/bin/python tools/blender/make_usd_skinning.py tests/data/scenes/usd_pipeline
 """
 
 import math

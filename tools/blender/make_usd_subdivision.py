@@ -3,7 +3,7 @@
 modifier applied at its render level (Blender's own OpenSubdiv refinement, limit surface
 on). gridtrace refines the first; `tests/usd_pipeline.rs` compares it with the second.
 
-    /tmp/bpyenv/bin/python tools/blender/make_usd_subdivision.py tests/scenes/usd_pipeline
+    /tmp/bpyenv/bin/python tools/blender/make_usd_subdivision.py tests/data/scenes/usd_pipeline
 
 Objects (seen by a camera, lit by a sun): a cube (every vertex of valence 3), a capped cylinder (n-gon caps, valence 3 and
 4), and a grid with an open boundary (corners kept, as USD's edgeAndCorner default), each

@@ -6,10 +6,10 @@ Run from the repository root with the PyPI `bpy` package (Blender as a Python mo
     pip install bpy==5.0.1
     python3 tools/blender/make_view_transform_ramp.py
 
-Writes `tests/references/view_ramp.exr`, a linear Rec.709 image whose columns step
+Writes `tests/data/references/view_ramp.exr`, a linear Rec.709 image whose columns step
 exposure from 12 stops under to 10 stops over middle grey (0.18) and whose rows are
 grey and a set of saturated and unsaturated colours, and
-`tests/references/view_ramp_agx.png`, that EXR saved by Blender "as render" through
+`tests/data/references/view_ramp_agx.png`, that EXR saved by Blender "as render" through
 the sRGB display's AgX view (Blender 5's default), exposure 0, gamma 1, no look.
 """
 
@@ -49,7 +49,7 @@ def ramp_pixels():
 
 def main():
     root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
-    out = os.path.join(root, "tests", "references")
+    out = os.path.join(root, "tests", "data", "references")
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     image = bpy.data.images.new("view_ramp", WIDTH, len(COLOURS), alpha=True, float_buffer=True)

@@ -28,7 +28,7 @@ built=$(cargo bench --bench accel --no-run --quiet --message-format=json |
   exit 1
 }
 cp "$built" "$work/accel"
-echo "accel-bench-processes: $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src benches tests/oracles Cargo.toml Cargo.lock || echo ' with uncommitted changes'), built once" >&2
+echo "accel-bench-processes: $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src benches tests/support/oracles Cargo.toml Cargo.lock || echo ' with uncommitted changes'), built once" >&2
 rows=$work/rows
 warm=$work/warm
 for ((p = 1; p <= processes; p++)); do

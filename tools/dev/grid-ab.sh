@@ -45,7 +45,7 @@ glam = "$glam"
 [workspace]
 TOML
 cp "$root/tools/dev/grid-ab/main.rs" "$work/harness/src/main.rs"
-cp "$root/tests/oracles/rays.rs" "$work/harness/src/rays.rs"
+cp "$root/tests/support/oracles/rays.rs" "$work/harness/src/rays.rs"
 cp "$root/Cargo.lock" "$work/harness/Cargo.lock"
 echo "grid-ab: this tree against $commit; building" >&2
 cargo build --release --quiet --manifest-path "$work/harness/Cargo.toml" \

@@ -1,8 +1,8 @@
-"""Write the corpus of broken and hostile scene files in tests/bad/.
+"""Write the corpus of broken and hostile scene files in tests/data/bad/.
 
 Run from the repository root: python3 tools/dev/make_bad_inputs.py
 Each file is small and made here from scratch (the truncated .glb is cut from the bundled
-Cornell box). tests/bad_inputs.rs says what gridtrace must do with each one.
+Cornell box). tests/data/bad_inputs.rs says what gridtrace must do with each one.
 """
 
 import base64
@@ -11,7 +11,7 @@ import os
 import struct
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-OUT = os.path.join(ROOT, "tests", "bad")
+OUT = os.path.join(ROOT, "tests", "data", "bad")
 
 QUAD = [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]
 QUAD_INDICES = [0, 1, 2, 0, 2, 3]

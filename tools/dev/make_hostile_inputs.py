@@ -8,7 +8,7 @@ OUT/secret.txt and OUT/secret.usda lie outside the scenes' folder OUT/scenes/, w
 every scene; some cases need special files (a FIFO, a symbolic link, a sparse 3 GB file),
 which is why the corpus is made at test time rather than committed. tests/hostile.rs says
 what gridtrace must do with each case. Everything here is written from scratch except the
-corrupt binary USD layer, which is the fuzzer's crasher in tests/fuzz_crashes/usd/.
+corrupt binary USD layer, which is the fuzzer's crasher in tests/data/fuzz_crashes/usd/.
 """
 
 import gzip
@@ -209,7 +209,7 @@ def Mesh "Floor"
 """))
 
     # 2. Aborts: a corrupt binary layer behind a text one; nesting past any stack.
-    with open(os.path.join(ROOT, "tests", "fuzz_crashes", "usd", "oom-usdc-open.usdc"), "rb") as f:
+    with open(os.path.join(ROOT, "tests", "data", "fuzz_crashes", "usd", "oom-usdc-open.usdc"), "rb") as f:
         write(j("corrupt.usdc"), f.read())
     write(j("usd_corrupt_reference.usda"), usda("def Xform \"Ref\" (\n    prepend references = @corrupt.usdc@\n)\n{\n}\n"))
     write(j("usd_corrupt_sublayer.usda"), usda(metadata="    subLayers = [@corrupt.usdc@]\n"))

@@ -2,7 +2,7 @@
 camera. Run with a Python that has `trimesh`, `pygltflib` and `usd-core` (PyPI):
 
     python3 -m venv /tmp/tp && /tmp/tp/bin/pip install trimesh pygltflib usd-core numpy
-    /tmp/tp/bin/python tools/dev/make_third_party.py tests/scenes/third_party
+    /tmp/tp/bin/python tools/dev/make_third_party.py tests/data/scenes/third_party
 
 - `trimesh_shapes.glb`: trimesh's glTF exporter, an icosphere on a box with colours.
 - `pygltflib_plate.gltf`: a flat square lying in the ground plane (Y up), written

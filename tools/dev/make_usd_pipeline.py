@@ -4,7 +4,7 @@ itself rather than against our reading of the specification. Run with a Python t
 `usd-core` and `pillow` (PyPI):
 
     python3 -m venv /tmp/tp && /tmp/tp/bin/pip install usd-core pillow
-    /tmp/tp/bin/python tools/dev/make_usd_pipeline.py tests/scenes/usd_pipeline
+    /tmp/tp/bin/python tools/dev/make_usd_pipeline.py tests/data/scenes/usd_pipeline
 
 Stages (Y up, metres, so USD's numbers are gridtrace's):
 - `assets/`: a root stage with a sublayer and a reference in other folders, each naming a

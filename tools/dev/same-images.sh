@@ -22,24 +22,24 @@ cases=(
   "box_glb|assets/cornell_box.glb --spp 8 --width 96 -o OUT.exr"
   "box_png_agx|assets/cornell_box.glb --spp 4 --width 64 --view-transform agx --exposure 0.5 -o OUT.png"
   "box_usdc|assets/cornell_box.usdc --spp 8 --width 96 -o OUT.exr"
-  "box_usdz|tests/scenes/cornell_box.usdz --spp 4 --width 64 -o OUT.exr"
+  "box_usdz|tests/data/scenes/cornell_box.usdz --spp 4 --width 64 -o OUT.exr"
   "spheres_aov|assets/cornell_spheres.glb --spp 8 --width 96 --aov all -o OUT.exr"
   "spheres_filter|assets/cornell_spheres.glb --spp 4 --width 64 --filter blackman-harris -o OUT.exr"
-  "textured|tests/scenes/textured.glb --spp 8 --width 96 -o OUT.exr"
-  "principled_usdc|tests/scenes/principled_textured.usdc --spp 4 --width 96 -o OUT.exr"
-  "glass|tests/scenes/principled_glass.glb --spp 4 --width 96 --max-depth 32 -o OUT.exr"
-  "punctual|tests/scenes/punctual_lights.usdc --spp 4 --width 96 -o OUT.exr"
-  "lamps|tests/scenes/lighting_lamps.usdc --spp 4 --width 96 -o OUT.exr"
-  "hdr_env|tests/scenes/lighting_hdr.glb --spp 4 --width 96 --environment tests/scenes/textures/lighting_sky.hdr --environment-rotation 30 -o OUT.exr"
-  "sun_env|tests/scenes/lighting_sun_sky.glb --spp 4 --width 96 --environment 0.3,0.45,0.7 --hide-environment -o OUT.exr"
-  "dof_usd|tests/scenes/lighting_dof.usdc --spp 4 --width 96 -o OUT.exr"
+  "textured|tests/data/scenes/textured.glb --spp 8 --width 96 -o OUT.exr"
+  "principled_usdc|tests/data/scenes/principled_textured.usdc --spp 4 --width 96 -o OUT.exr"
+  "glass|tests/data/scenes/principled_glass.glb --spp 4 --width 96 --max-depth 32 -o OUT.exr"
+  "punctual|tests/data/scenes/punctual_lights.usdc --spp 4 --width 96 -o OUT.exr"
+  "lamps|tests/data/scenes/lighting_lamps.usdc --spp 4 --width 96 -o OUT.exr"
+  "hdr_env|tests/data/scenes/lighting_hdr.glb --spp 4 --width 96 --environment tests/data/scenes/textures/lighting_sky.hdr --environment-rotation 30 -o OUT.exr"
+  "sun_env|tests/data/scenes/lighting_sun_sky.glb --spp 4 --width 96 --environment 0.3,0.45,0.7 --hide-environment -o OUT.exr"
+  "dof_usd|tests/data/scenes/lighting_dof.usdc --spp 4 --width 96 -o OUT.exr"
   "dof_flags|assets/cornell_spheres.glb --spp 4 --width 64 --fstop 1.4 --focus-distance 3 -o OUT.exr"
-  "motion_usd|tests/scenes/animated.usdc --frame 6 --shutter=-0.5..0.5 --motion-steps 3 --spp 4 --width 64 -o OUT.exr"
-  "gltf_anim|tests/scenes/gltf_animation/animated.glb --frame 7 --shutter=-0.25..0.25 --spp 4 --width 64 -o OUT.exr"
+  "motion_usd|tests/data/scenes/animated.usdc --frame 6 --shutter=-0.5..0.5 --motion-steps 3 --spp 4 --width 64 -o OUT.exr"
+  "gltf_anim|tests/data/scenes/gltf_animation/animated.glb --frame 7 --shutter=-0.25..0.25 --spp 4 --width 64 -o OUT.exr"
   "adaptive|assets/cornell_box.glb --spp 64 --noise-threshold 0.05 --width 48 -o OUT.exr"
   "part0|assets/cornell_box.glb --samples 0..4 --width 64 -o OUT.exr"
   "part1|assets/cornell_box.glb --samples 4..8 --width 64 -o OUT.exr"
-  "default_light|tests/scenes/material_details.glb --spp 4 --width 64 -o OUT.exr"
+  "default_light|tests/data/scenes/material_details.glb --spp 4 --width 64 -o OUT.exr"
 )
 if [[ -n "$ply" ]]; then
   cases+=("ply|$ply --spp 4 --width 64 -o OUT.exr")
@@ -77,7 +77,7 @@ for side in before after; do
   bin=$before; [[ $side == after ]] && bin=$after
   "$bin" merge "$work/$side/part0.exr" "$work/$side/part1.exr" --samples 0..8 -q \
     -o "$work/$side/merged.exr" >"$work/$side/merged.log" 2>&1 || true
-  "$bin" --inspect tests/scenes/principled_textured.glb >"$work/$side/inspect.log" 2>&1 || true
+  "$bin" --inspect tests/data/scenes/principled_textured.glb >"$work/$side/inspect.log" 2>&1 || true
   # Help may be reworded or regrouped; the options it offers may not change.
   for command in "" merge denoise; do
     # shellcheck disable=SC2086

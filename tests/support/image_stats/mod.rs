@@ -114,7 +114,7 @@ pub fn read_exr(path: &Path) -> Vec<DVec3> {
 }
 
 pub fn reference(name: &str) -> Halves {
-    let dir = Path::new("tests/references");
+    let dir = Path::new("tests/data/references");
     Halves {
         a: read_exr(&dir.join(format!("{name}_a.exr"))),
         b: read_exr(&dir.join(format!("{name}_b.exr"))),
@@ -126,7 +126,7 @@ pub fn scene_path(name: &str) -> PathBuf {
     if asset.exists() {
         asset
     } else {
-        Path::new("tests/scenes").join(format!("{name}.glb"))
+        Path::new("tests/data/scenes").join(format!("{name}.glb"))
     }
 }
 
