@@ -40,6 +40,13 @@ fn options_listed(args: &[&str]) -> BTreeSet<String> {
     options
 }
 
+/// True when `text` names `option` as a whole word (`--spp` is not found in `--spp-x`).
+fn mentions(text: &str, option: &str) -> bool {
+    text.match_indices(option).any(|(i, _)| {
+        !text[i + option.len()..].starts_with(|c: char| c.is_ascii_alphanumeric() || c == '-')
+    })
+}
+
 #[test]
 fn every_option_is_in_the_command_line_page() {
     let page = fs::read_to_string(repo().join("docs/manual/command-line.md")).unwrap();
@@ -51,7 +58,7 @@ fn every_option_is_in_the_command_line_page() {
             "too few options found for {command:?}: {options:?}"
         );
         for option in options {
-            if !page.contains(&format!("`{option}")) {
+            if !mentions(&page, &option) {
                 missing.push(format!("{} {option}", command.join(" ")));
             }
         }
@@ -173,6 +180,8 @@ fn the_link_checker_finds_links_and_anchors() {
     assert_eq!(link_targets(text), vec!["x.md#one-two", "p.png"]);
     assert_eq!(anchor_of(" One, two: (three)"), "one-two-three");
     assert!(anchors("# Title\n## Layers, denoising\n").contains("layers-denoising"));
+    assert!(mentions("`-o, --output FILE`", "--output"));
+    assert!(!mentions("`--spp-range`", "--spp"));
 }
 
 /// The project's own text files: the README, docs, sources, tests, tools and benchmarks.

@@ -482,7 +482,10 @@ fn bad_punctual_lights_are_skipped_with_a_warning() {
 /// all three arrive, at Cycles' strengths.
 #[test]
 fn blender_exported_lights_arrive_at_cycles_strengths() {
-    let loaded = load_scene(std::path::Path::new("tests/data/scenes/punctual_lights.glb")).unwrap();
+    let loaded = load_scene(std::path::Path::new(
+        "tests/data/scenes/punctual_lights.glb",
+    ))
+    .unwrap();
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
     let lights = &loaded.scene.lights;
     assert_eq!(lights.len(), 3, "{lights:?}");

@@ -209,7 +209,10 @@ fn texture_transform_follows_the_extensions_example() {
 /// density 2 → attenuationDistance 0.5) and of a rough metal.
 #[test]
 fn blender_volume_glass_and_rough_metal() {
-    let loaded = load_scene(std::path::Path::new("tests/data/scenes/material_details.glb")).unwrap();
+    let loaded = load_scene(std::path::Path::new(
+        "tests/data/scenes/material_details.glb",
+    ))
+    .unwrap();
     let materials = &loaded.scene.materials;
     let glass = materials.iter().find(|m| m.name == "TintedGlass").unwrap();
     assert!(glass.pbr.transmission == 1.0 && glass.pbr.ior == 1.5 && glass.pbr.roughness == 0.0);

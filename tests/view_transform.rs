@@ -23,7 +23,8 @@ fn ramp() -> Image {
 }
 
 fn blender_agx() -> Vec<u8> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/references/view_ramp_agx.png");
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/references/view_ramp_agx.png");
     image::open(path).unwrap().to_rgb8().into_raw()
 }
 

@@ -53,30 +53,41 @@ pub fn describe(scene: &Scene, warnings: &[String]) -> String {
             light_summary(&light.kind)
         );
     }
-    match &scene.environment {
-        None => {
-            let _ = writeln!(out, "environment: none");
-        }
-        Some(e) => {
-            let what = match &e.map {
-                None => format!("constant radiance {}", vector(e.tint)),
-                Some(m) => format!(
-                    "map {} ({}x{}) × {}, mean radiance {}",
-                    m.name,
-                    m.width,
-                    m.height,
-                    vector(e.tint),
-                    vector(e.mean_radiance())
-                ),
-            };
-            let hidden = if e.camera_visible {
-                ""
-            } else {
-                ", hidden from the camera"
-            };
-            let _ = writeln!(out, "environment ({}): {what}{hidden}", e.source);
-        }
+    let _ = writeln!(out, "{}", environment_summary(scene));
+    describe_cameras(&mut out, scene);
+    let _ = writeln!(out, "warnings: {}", warnings.len());
+    for w in warnings {
+        let _ = writeln!(out, "  {w}");
     }
+    out
+}
+
+/// The environment line: none, a constant radiance, or a map with its scale and mean.
+fn environment_summary(scene: &Scene) -> String {
+    let Some(e) = &scene.environment else {
+        return "environment: none".to_string();
+    };
+    let what = match &e.map {
+        None => format!("constant radiance {}", vector(e.tint)),
+        Some(m) => format!(
+            "map {} ({}x{}) × {}, mean radiance {}",
+            m.name,
+            m.width,
+            m.height,
+            vector(e.tint),
+            vector(e.mean_radiance())
+        ),
+    };
+    let hidden = if e.camera_visible {
+        ""
+    } else {
+        ", hidden from the camera"
+    };
+    format!("environment ({}): {what}{hidden}", e.source)
+}
+
+/// The cameras: projection, position and near plane of each.
+fn describe_cameras(out: &mut String, scene: &Scene) {
     let _ = writeln!(out, "cameras: {}", scene.cameras.len());
     for (i, c) in scene.cameras.iter().enumerate() {
         let position = c.world_from_camera.transform_point3(Vec3::ZERO);
@@ -100,11 +111,6 @@ pub fn describe(scene: &Scene, warnings: &[String]) -> String {
             c.znear
         );
     }
-    let _ = writeln!(out, "warnings: {}", warnings.len());
-    for w in warnings {
-        let _ = writeln!(out, "  {w}");
-    }
-    out
 }
 
 fn vector(v: Vec3) -> String {

@@ -2,7 +2,7 @@
 
 Run from the repository root: python3 tools/dev/make_bad_inputs.py
 Each file is small and made here from scratch (the truncated .glb is cut from the bundled
-Cornell box). tests/data/bad_inputs.rs says what gridtrace must do with each one.
+Cornell box). tests/bad_inputs.rs says what gridtrace must do with each one.
 """
 
 import base64
