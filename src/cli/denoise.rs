@@ -5,7 +5,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 
 use super::args::DenoiseArgs;
-use super::signals::{Phase, check_output, write_output};
+use super::signals::{check_output, write_last};
 use crate::limits::{check_memory, set_memory_budget};
 use crate::output::denoise::denoise;
 use crate::output::merge::read_part;
@@ -55,13 +55,7 @@ pub fn run_denoise(args: &DenoiseArgs) -> Result<()> {
     denoise_for_output(&mut image, args.threads, args.quiet)?;
     let mut record = part.record;
     record.denoised = true;
-    write_output(
-        &args.output,
-        &image,
-        Some(&record),
-        args.view_transform.into(),
-        Some(Phase::Finished),
-    )?;
+    write_last(&args.output, &image, &record, args.view_transform.into())?;
     if !args.quiet {
         eprintln!("wrote {}", args.output.display());
     }

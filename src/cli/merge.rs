@@ -6,7 +6,7 @@ use anyhow::Result;
 
 use super::args::MergeArgs;
 use super::denoise::denoise_for_output;
-use super::signals::{Phase, check_output, write_output};
+use super::signals::{check_output, write_last};
 use crate::limits::set_memory_budget;
 use crate::output::denoise::check_available;
 use crate::output::merge::merge_files;
@@ -31,13 +31,7 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
         denoise_for_output(&mut image, args.threads, args.quiet)?;
         record.denoised = true;
     }
-    write_output(
-        &args.output,
-        &image,
-        Some(&record),
-        args.view_transform.into(),
-        Some(Phase::Finished),
-    )?;
+    write_last(&args.output, &image, &record, args.view_transform.into())?;
     if !args.quiet {
         eprintln!(
             "merged {} part(s) of {} ({}x{}, camera {}): samples {} in {:.2} s; wrote {}",

@@ -77,6 +77,16 @@ pub fn write_output(
     Ok(())
 }
 
+/// Writes a run's last output, with its record, and enters [`Phase::Finished`].
+pub fn write_last(
+    path: &Path,
+    image: &Image,
+    record: &RenderRecord,
+    view: ViewTransform,
+) -> Result<(), OutputError> {
+    write_output(path, image, Some(record), view, Some(Phase::Finished))
+}
+
 /// The exit code for a run that a signal stopped: 128 + its number (130 for SIGINT, 143 for
 /// SIGTERM, 129 for SIGHUP), as shells report it.
 pub fn interrupted_exit_code() -> i32 {

@@ -8,7 +8,7 @@ use anyhow::Result;
 use super::super::Outcome;
 use super::super::args::Args;
 use super::super::denoise::denoise_for_output;
-use super::super::signals::{Phase, write_output};
+use super::super::signals::write_last;
 use super::passes::Rendered;
 use super::plan::Plan;
 use super::prepare::Prepared;
@@ -65,13 +65,7 @@ pub fn finish(
     }
     let record = recorder.record(&image, &stats);
     let view = args.image.view_transform.into();
-    write_output(
-        &plan.output,
-        &image,
-        Some(&record),
-        view,
-        Some(Phase::Finished),
-    )?;
+    write_last(&plan.output, &image, &record, view)?;
     if !args.image.quiet {
         let seconds = stats.elapsed.as_secs_f64().max(1e-9);
         let range = match args.sampling.samples {

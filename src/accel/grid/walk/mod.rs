@@ -33,30 +33,22 @@ impl Grid {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
-        match (self.cells.unit_shift(), self.cells.box_margin().is_some()) {
-            (0, false) => self.intersect_at::<0, false>(ray, stats),
-            (0, true) => self.intersect_at::<0, true>(ray, stats),
-            (_, false) => self.intersect_at::<1, false>(ray, stats),
-            (_, true) => self.intersect_at::<1, true>(ray, stats),
-        }
+        self.ask(Intersect { ray, stats })
     }
 
-    /// [`Grid::intersect_counting`] for a grid whose reaches are kept per unit of
-    /// 2^`UNIT` cells ([`crate::accel::grid::storage::cell_reach`]): each unit's walk compiled in functions of
-    /// its own, so that neither pays for the other's code (in one function, the 11k
-    /// dragon's queries took 1.01–1.03 the time).
+    /// Runs `query` in the walk compiled for this grid: reaches per cell or per 2³ unit of
+    /// cells ([`crate::accel::grid::storage::cell_reach`]), with or without cell boxes,
+    /// each compiled in functions of its own so that no grid pays for another's code (in
+    /// one function, the 11k dragon's queries took 1.01–1.03 the time), and each for the
+    /// widest instruction set the processor has ([`dispatch`]).
     #[inline(always)]
-    fn intersect_at<const UNIT: u32, const BOXED: bool>(
-        &self,
-        ray: &Ray,
-        stats: &mut impl TraversalStats,
-    ) -> Option<GridHit> {
-        let query = Intersect::<_, UNIT, BOXED> {
-            grid: self,
-            ray,
-            stats,
-        };
-        dispatch(X86Level::Avx512, query)
+    fn ask<Q: Query>(&self, query: Q) -> Q::Output {
+        match (self.cells.unit_shift(), self.cells.box_margin().is_some()) {
+            (0, false) => dispatch(X86Level::Avx512, Asked::<Q, 0, false> { grid: self, query }),
+            (0, true) => dispatch(X86Level::Avx512, Asked::<Q, 0, true> { grid: self, query }),
+            (_, false) => dispatch(X86Level::Avx512, Asked::<Q, 1, false> { grid: self, query }),
+            (_, true) => dispatch(X86Level::Avx512, Asked::<Q, 1, true> { grid: self, query }),
+        }
     }
 
     #[inline(always)]
@@ -91,23 +83,7 @@ impl Grid {
     /// cells given out. For the benchmark, to split a query's time between the walk and the
     /// triangles.
     pub fn walk(&self, ray: &Ray, t_stop: f32) -> usize {
-        match (self.cells.unit_shift(), self.cells.box_margin().is_some()) {
-            (0, false) => self.walk_at::<0, false>(ray, t_stop),
-            (0, true) => self.walk_at::<0, true>(ray, t_stop),
-            (_, false) => self.walk_at::<1, false>(ray, t_stop),
-            (_, true) => self.walk_at::<1, true>(ray, t_stop),
-        }
-    }
-
-    /// [`Grid::walk`] for units of 2^`UNIT` cells, as [`Grid::intersect_at`].
-    #[inline(always)]
-    fn walk_at<const UNIT: u32, const BOXED: bool>(&self, ray: &Ray, t_stop: f32) -> usize {
-        let walk = Walk::<UNIT, BOXED> {
-            grid: self,
-            ray,
-            t_stop,
-        };
-        dispatch(X86Level::Avx512, walk)
+        self.ask(Walk { ray, t_stop })
     }
 
     #[inline(always)]
@@ -134,27 +110,7 @@ impl Grid {
 
     /// [`Grid::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        match (self.cells.unit_shift(), self.cells.box_margin().is_some()) {
-            (0, false) => self.occluded_at::<0, false>(ray, stats),
-            (0, true) => self.occluded_at::<0, true>(ray, stats),
-            (_, false) => self.occluded_at::<1, false>(ray, stats),
-            (_, true) => self.occluded_at::<1, true>(ray, stats),
-        }
-    }
-
-    /// [`Grid::occluded_counting`] for units of 2^`UNIT` cells, as [`Grid::intersect_at`].
-    #[inline(always)]
-    fn occluded_at<const UNIT: u32, const BOXED: bool>(
-        &self,
-        ray: &Ray,
-        stats: &mut impl TraversalStats,
-    ) -> bool {
-        let query = Occluded::<_, UNIT, BOXED> {
-            grid: self,
-            ray,
-            stats,
-        };
-        dispatch(X86Level::Avx512, query)
+        self.ask(Occluded { ray, stats })
     }
 
     /// The cells are walked from the segment's far end back to its origin (the answer does
@@ -190,55 +146,74 @@ impl Grid {
     }
 }
 
-/// The closest-hit query as a [`Kernel`], compiled for each instruction set.
-struct Intersect<'a, S, const UNIT: u32, const BOXED: bool> {
+/// A query of the grid, written once for every form of grid and instruction set.
+trait Query {
+    /// What it answers.
+    type Output;
+    /// Asks it of `grid`, whose reaches are per unit of 2^`UNIT` cells and which keeps
+    /// cell boxes if `BOXED`, with fused multiply-adds if `FUSED`.
+    fn run<const FUSED: bool, const UNIT: u32, const BOXED: bool>(
+        self,
+        grid: &Grid,
+    ) -> Self::Output;
+}
+
+/// A query of one form of grid, as a [`Kernel`] for [`dispatch`].
+struct Asked<'a, Q, const UNIT: u32, const BOXED: bool> {
     grid: &'a Grid,
+    query: Q,
+}
+
+impl<Q: Query, const UNIT: u32, const BOXED: bool> Kernel for Asked<'_, Q, UNIT, BOXED> {
+    type Output = Q::Output;
+    #[inline(always)]
+    fn run<const FUSED: bool>(self) -> Q::Output {
+        self.query.run::<FUSED, UNIT, BOXED>(self.grid)
+    }
+}
+
+/// The closest-hit query.
+struct Intersect<'a, S> {
     ray: &'a Ray,
     stats: &'a mut S,
 }
 
-impl<S: TraversalStats, const UNIT: u32, const BOXED: bool> Kernel
-    for Intersect<'_, S, UNIT, BOXED>
-{
+impl<S: TraversalStats> Query for Intersect<'_, S> {
     type Output = Option<GridHit>;
     #[inline(always)]
-    fn run<const FUSED: bool>(self) -> Option<GridHit> {
-        self.grid
-            .intersect_portable::<FUSED, UNIT, BOXED>(self.ray, self.stats)
+    fn run<const FUSED: bool, const UNIT: u32, const BOXED: bool>(
+        self,
+        grid: &Grid,
+    ) -> Option<GridHit> {
+        grid.intersect_portable::<FUSED, UNIT, BOXED>(self.ray, self.stats)
     }
 }
 
-/// The shadow query as a [`Kernel`].
-struct Occluded<'a, S, const UNIT: u32, const BOXED: bool> {
-    grid: &'a Grid,
+/// The shadow query.
+struct Occluded<'a, S> {
     ray: &'a Ray,
     stats: &'a mut S,
 }
 
-impl<S: TraversalStats, const UNIT: u32, const BOXED: bool> Kernel
-    for Occluded<'_, S, UNIT, BOXED>
-{
+impl<S: TraversalStats> Query for Occluded<'_, S> {
     type Output = bool;
     #[inline(always)]
-    fn run<const FUSED: bool>(self) -> bool {
-        self.grid
-            .occluded_portable::<FUSED, UNIT, BOXED>(self.ray, self.stats)
+    fn run<const FUSED: bool, const UNIT: u32, const BOXED: bool>(self, grid: &Grid) -> bool {
+        grid.occluded_portable::<FUSED, UNIT, BOXED>(self.ray, self.stats)
     }
 }
 
-/// The walk alone ([`Grid::walk`]) as a [`Kernel`].
-struct Walk<'a, const UNIT: u32, const BOXED: bool> {
-    grid: &'a Grid,
+/// The walk alone ([`Grid::walk`]).
+struct Walk<'a> {
     ray: &'a Ray,
     t_stop: f32,
 }
 
-impl<const UNIT: u32, const BOXED: bool> Kernel for Walk<'_, UNIT, BOXED> {
+impl Query for Walk<'_> {
     type Output = usize;
     #[inline(always)]
-    fn run<const FUSED: bool>(self) -> usize {
-        self.grid
-            .walk_portable::<FUSED, UNIT, BOXED>(self.ray, self.t_stop)
+    fn run<const FUSED: bool, const UNIT: u32, const BOXED: bool>(self, grid: &Grid) -> usize {
+        grid.walk_portable::<FUSED, UNIT, BOXED>(self.ray, self.t_stop)
     }
 }
 
@@ -458,10 +433,12 @@ mod tests {
             ray.t_max = 1.5;
             let blocked = grid.occluded_portable::<false, 0, false>(&ray, &mut ());
             assert_eq!(grid.occluded(&ray), blocked, "ray {k}: {ray:?}");
-            let query = Occluded::<_, 0, false> {
+            let query = Asked::<_, 0, false> {
                 grid: &grid,
-                ray: &ray,
-                stats: &mut (),
+                query: Occluded {
+                    ray: &ray,
+                    stats: &mut (),
+                },
             };
             assert_eq!(dispatch(X86Level::Avx2, query), blocked, "ray {k}: {ray:?}");
         }
