@@ -419,10 +419,12 @@ mod tests {
             let portable = grid.intersect_portable::<false, 0, false>(&ray, &mut ());
             assert_eq!(fast, portable, "ray {k}: {ray:?}");
             // On a processor with AVX-512, the AVX2 version too.
-            let query = Intersect::<_, 0, false> {
+            let query = Asked::<_, 0, false> {
                 grid: &grid,
-                ray: &ray,
-                stats: &mut (),
+                query: Intersect {
+                    ray: &ray,
+                    stats: &mut (),
+                },
             };
             assert_eq!(
                 dispatch(X86Level::Avx2, query),
