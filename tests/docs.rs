@@ -223,7 +223,8 @@ fn project_texts() -> Vec<PathBuf> {
 }
 
 /// The repository describes gridtrace as it is; who did what when belongs in `git log`.
-/// So no text names a numbered work period ("the ninth session") or an issue number.
+/// So no text names a numbered work period (an ordinal before the word for one) or an
+/// issue number.
 #[test]
 fn no_text_tells_the_projects_history() {
     let ordinals = [

@@ -9,7 +9,7 @@
 use glam::UVec3;
 
 use super::Ray;
-use super::grid::walk::frame::{GridFrame, padded, resolution};
+use super::grid::frame::{GridFrame, padded, resolution};
 use crate::geometry::Aabb;
 
 /// Cells per instance aimed for (λ of Cleary & Wyvill 1988). Instances are larger than

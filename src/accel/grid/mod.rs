@@ -15,18 +15,20 @@
 //! current cell.
 
 mod build;
+mod cell_lanes;
+pub(crate) mod frame;
 mod storage;
 pub(crate) mod walk;
 
-pub use walk::{TraversalCounts, TraversalStats};
+pub use walk::stats::{TraversalCounts, TraversalStats};
 
 use glam::{UVec3, Vec3};
 
 use crate::geometry::Aabb;
+use frame::GridFrame;
 use storage::block::{self, Block};
 use storage::cell_box;
 use storage::cells::{CellIndex, Lookup};
-use walk::frame::GridFrame;
 
 /// A uniform grid accelerating ray queries against one triangle list.
 #[derive(Clone, Debug)]

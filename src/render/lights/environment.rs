@@ -7,7 +7,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::LightSample;
+use super::sample::LightSample;
 use super::tree::{Distant, TreeInput};
 use crate::render::sampling::{Distribution2d, uniform_sphere};
 use crate::scene::{Environment, EnvironmentMap, map_direction, map_uv};

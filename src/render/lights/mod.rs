@@ -7,6 +7,7 @@
 
 mod environment;
 mod punctual;
+mod sample;
 mod sphere;
 mod spherical;
 mod tree;
@@ -15,34 +16,12 @@ mod triangle;
 use glam::{Vec2, Vec3};
 
 pub use environment::EnvironmentLight;
+pub use sample::LightSample;
 pub use triangle::EmissiveTriangles;
 
 use super::sampling::Distribution1d;
 use crate::scene::{LightKind, Scene};
 use tree::{LightTree, TreeInput};
-
-/// A point drawn on a light, as seen from a shading point.
-#[derive(Clone, Copy, Debug)]
-pub struct LightSample {
-    /// The point on the light.
-    pub point: Vec3,
-    /// Bound on the rounding error of `point`, per axis.
-    pub point_error: Vec3,
-    /// The light's unit normal there (front side).
-    pub normal: Vec3,
-    /// Unit direction from the shading point to the light point.
-    pub wi: Vec3,
-    /// Distance from the shading point to the light point.
-    pub distance: f32,
-    /// Radiance leaving the light towards the shading point.
-    pub radiance: Vec3,
-    /// Solid-angle density of `wi` at the shading point; for a punctual light, the
-    /// probability of having picked it.
-    pub pdf: f32,
-    /// True for a punctual light: `radiance` is then the irradiance it brings to a surface
-    /// facing it, and no ray can find the light, so there is nothing to weigh against.
-    pub is_delta: bool,
-}
 
 /// One light of a [`LightSet`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -5,7 +5,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::LightSample;
+use super::sample::LightSample;
 use super::sphere;
 use super::tree::{Cone, Distant, LightBounds, TreeInput};
 use crate::geometry::Aabb;

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use glam::{Affine3A, Vec2, Vec3};
 
-use super::LightSample;
+use super::sample::LightSample;
 use super::spherical;
 use super::tree::{Cone, LightBounds, TreeInput};
 use crate::geometry::Aabb;

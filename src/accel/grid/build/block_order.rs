@@ -14,7 +14,7 @@ use glam::{IVec3, UVec3, Vec3};
 use rayon::prelude::*;
 
 use crate::accel::grid::build::mesh_triangles::MeshTriangles;
-use crate::accel::grid::walk::frame::GridFrame;
+use crate::accel::grid::frame::GridFrame;
 use crate::geometry::Aabb;
 
 /// Steps per cell along each axis of the key (4 bits).

@@ -10,7 +10,7 @@
 
 use rayon::prelude::*;
 
-use crate::accel::grid::storage::cells::MACRO_CELLS;
+use crate::accel::grid::storage::macrocell::MACRO_CELLS;
 
 /// Parts the keys are cut into, at most: enough for two threads to share the work evenly
 /// however the occupied macrocells cluster, few enough that a chunk's buckets stay small.

@@ -17,7 +17,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use rayon::prelude::*;
 
 use crate::accel::grid::build::mesh_triangles::MeshTriangles;
-use crate::accel::grid::walk::frame::{GridFrame, resolution};
+use crate::accel::grid::frame::{GridFrame, resolution};
 use crate::geometry::Aabb;
 
 /// λ for evenly spread triangles (the Stanford dragons of 11k and 203k triangles: 1.02–1.10×

@@ -13,13 +13,14 @@ use rayon::prelude::*;
 use super::Grid;
 use crate::accel::grid::storage::block::{Block, LANES};
 use crate::accel::grid::storage::cell_box::{self, Kept};
-use crate::accel::grid::storage::cells::{CellIndex, MACRO_CELLS};
+use crate::accel::grid::storage::cells::CellIndex;
+use crate::accel::grid::storage::macrocell::MACRO_CELLS;
 use block_order::CellRun;
 use cell_order::{Buckets, CellOrder, KeyParts};
 use mesh_triangles::MeshTriangles;
 use overlap::{Polygon, TriangleBoxTest};
 
-use crate::accel::grid::walk::frame::{GridFrame, padded, resolution};
+use crate::accel::grid::frame::{GridFrame, padded, resolution};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::isa::{Kernel, X86Level, dispatch};
 use crate::accel::{Triangle, huge_pages};

@@ -45,8 +45,8 @@ use std::ops::Range;
 use glam::{IVec3, Vec3, Vec3A};
 
 use crate::accel::Triangle;
+use crate::accel::grid::frame::{CellWalk, GridFrame};
 use crate::accel::grid::storage::block::{Block, LANES};
-use crate::accel::grid::walk::frame::{CellWalk, GridFrame};
 use crate::geometry::Aabb;
 
 /// Grids whose blocks take more bytes than this keep a box per occupied cell: about half a

@@ -25,7 +25,7 @@
 //! `and`s per row (along x, then y, then z) per side. A 2³ unit's reach is then that of
 //! its cell nearest the octant's origin, whose cubes of two or more cells cover the unit.
 
-use crate::accel::grid::storage::cells::MACRO_CELLS;
+use super::macrocell::MACRO_CELLS;
 use crate::accel::grid::storage::reach::moves_up;
 
 /// Cells along a macrocell's edge.

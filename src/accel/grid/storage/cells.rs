@@ -21,10 +21,7 @@ use crate::accel::grid::build::box_counts::BoxCounts;
 use crate::accel::grid::storage::cell_reach;
 use crate::accel::grid::storage::reach;
 
-/// A macrocell is 2^MACRO_SHIFT cells along each axis.
-pub(in crate::accel::grid) const MACRO_SHIFT: i32 = 3;
-/// Cells per macrocell.
-pub(in crate::accel::grid) const MACRO_CELLS: usize = 1 << (3 * MACRO_SHIFT);
+use super::macrocell::{MACRO_CELLS, MACRO_SHIFT};
 
 /// Set in a macrocell's word when it is occupied; the other bits are then its record's
 /// index. (An empty macrocell's word is 0.)
@@ -244,7 +241,7 @@ impl CellIndex {
     }
 
     /// log2 of the side, in cells, of the units whose reaches the index keeps: the unit
-    /// shift [`crate::accel::grid::walk::frame::CellWalk::leave_cube`] takes.
+    /// shift [`crate::accel::grid::frame::CellWalk::leave_cube`] takes.
     #[inline(always)]
     pub fn unit_shift(&self) -> u32 {
         self.unit_shift

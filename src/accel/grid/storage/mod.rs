@@ -7,4 +7,5 @@ pub(in crate::accel::grid) mod block;
 pub(in crate::accel::grid) mod cell_box;
 pub(in crate::accel::grid) mod cell_reach;
 pub(in crate::accel::grid) mod cells;
+pub(in crate::accel::grid) mod macrocell;
 pub(in crate::accel::grid) mod reach;

@@ -26,8 +26,8 @@
 use glam::IVec3;
 use rayon::prelude::*;
 
+use super::macrocell::MACRO_SHIFT;
 use crate::accel::grid::build::box_counts::BoxCounts;
-use crate::accel::grid::storage::cells::MACRO_SHIFT;
 
 /// The longest side of a box, in cells: a side fits in a byte. (A ray through a grid of
 /// the largest resolution, 2048 cells a side, thus leaps at least nine times over empty

@@ -9,13 +9,11 @@
 
 use glam::UVec3;
 
-pub(crate) mod cell_lanes;
-pub(crate) mod frame;
 pub(in crate::accel::grid) mod occupied;
 pub(crate) mod prefetch;
-mod stats;
+pub(in crate::accel::grid) mod stats;
 
-pub use stats::{TraversalCounts, TraversalStats};
+use stats::TraversalStats;
 
 use super::{Grid, GridHit};
 use crate::accel::Ray;
@@ -221,6 +219,7 @@ impl Query for Walk<'_> {
 mod tests {
     use glam::Vec3;
 
+    use super::stats::TraversalCounts;
     use super::*;
     use crate::accel::Triangle;
     use crate::accel::grid::storage::cell_box::{self, MASKED_BLOCKS};

@@ -9,11 +9,12 @@ use glam::{UVec3, Vec3A};
 use super::stats::TraversalStats;
 use crate::accel::Ray;
 use crate::accel::grid::Grid;
+use crate::accel::grid::frame::CellWalk;
 use crate::accel::grid::storage::block::Block;
 use crate::accel::grid::storage::cell_box::{self, MASKED_BLOCKS};
-use crate::accel::grid::storage::cells::{Lookup, MACRO_SHIFT};
+use crate::accel::grid::storage::cells::Lookup;
+use crate::accel::grid::storage::macrocell::MACRO_SHIFT;
 use crate::accel::grid::storage::reach;
-use crate::accel::grid::walk::frame::CellWalk;
 use crate::accel::grid::walk::prefetch::prefetch;
 
 impl Grid {
