@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Exits 0 when two OpenEXR files hold the same image: the same header attributes and,
 channel by channel, the same bits in every sample (so -0 against 0 or two NaNs of different
-payloads count as different). Their bytes may still differ: the `exr` crate writes
-compressed chunks in whatever order its threads finish them.
+payloads count as different). Their bytes may still differ: a file whose line order is
+unspecified may hold its compressed blocks in any order (as the `exr` crate writes them
+when it is told no order), so one image can be written as different bytes.
 
     python3 tools/dev/exr-same.py A.exr B.exr
 

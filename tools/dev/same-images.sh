@@ -48,9 +48,9 @@ else
 fi
 
 status=0
-# EXRs by their header and the bits of every sample (tools/dev/exr-same.py: the exr crate
-# writes compressed chunks in the order its threads finish them, so one binary's files can
-# differ in bytes from run to run); everything else byte for byte.
+# EXRs by their header and the bits of every sample (tools/dev/exr-same.py: a binary that
+# writes blocks in unspecified order can write one image as different bytes); everything
+# else byte for byte.
 compare() { # name file_before file_after
   local same
   if [[ $2 == *.exr ]]; then
