@@ -252,6 +252,10 @@ struct TestsPerCell {
 }
 
 impl TraversalStats for TestsPerCell {
+    type Lent<'a> = &'a mut TestsPerCell;
+    fn lend(&mut self) -> &mut TestsPerCell {
+        self
+    }
     fn visit_occupied(&mut self) {
         self.cells.extend(self.open.replace(0));
     }

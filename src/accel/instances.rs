@@ -221,7 +221,7 @@ impl SceneAccel {
             TopIntersect {
                 accel: self,
                 ray,
-                stats,
+                stats: stats.lend(),
             },
         )
     }
@@ -319,7 +319,7 @@ impl SceneAccel {
             TopOccluded {
                 accel: self,
                 ray,
-                stats,
+                stats: stats.lend(),
             },
         )
     }
@@ -513,17 +513,18 @@ fn to_object(ray: &Ray, object_from_world: &Affine3A) -> Ray {
 /// The top level's closest-hit query as a [`Kernel`]: compiled for AVX2, where the list's
 /// box lanes are vectors of eight (the same operations on each lane, so the same answer;
 /// AVX-512 gained nothing here).
+/// Its counter is lent by value ([`TraversalStats::lend`]), as the grid's queries take theirs.
 struct TopIntersect<'a, S> {
     accel: &'a SceneAccel,
     ray: &'a Ray,
-    stats: &'a mut S,
+    stats: S,
 }
 
 impl<S: TraversalStats> Kernel for TopIntersect<'_, S> {
     type Output = Option<SceneHit>;
     #[inline(always)]
-    fn run<const FUSED: bool>(self) -> Option<SceneHit> {
-        self.accel.intersect_portable(self.ray, self.stats)
+    fn run<const FUSED: bool>(mut self) -> Option<SceneHit> {
+        self.accel.intersect_portable(self.ray, &mut self.stats)
     }
 }
 
@@ -531,14 +532,14 @@ impl<S: TraversalStats> Kernel for TopIntersect<'_, S> {
 struct TopOccluded<'a, S> {
     accel: &'a SceneAccel,
     ray: &'a Ray,
-    stats: &'a mut S,
+    stats: S,
 }
 
 impl<S: TraversalStats> Kernel for TopOccluded<'_, S> {
     type Output = bool;
     #[inline(always)]
-    fn run<const FUSED: bool>(self) -> bool {
-        self.accel.occluded_portable(self.ray, self.stats)
+    fn run<const FUSED: bool>(mut self) -> bool {
+        self.accel.occluded_portable(self.ray, &mut self.stats)
     }
 }
 

@@ -234,7 +234,11 @@ mod tests {
         for (i, p) in image.pixels.iter_mut().enumerate() {
             // Blocks that compress to different sizes, so they finish at different times.
             let x = (i * 2_654_435_761) % 1000;
-            *p = Vec3::new(x as f32 / 7.0, (i % 256) as f32, if i % 3 == 0 { 0.0 } else { 1.5 });
+            *p = Vec3::new(
+                x as f32 / 7.0,
+                (i % 256) as f32,
+                if i % 3 == 0 { 0.0 } else { 1.5 },
+            );
         }
         let first = encode(&image, Some(("gridtrace/record", "seed=0"))).unwrap();
         for _ in 0..12 {

@@ -22,7 +22,7 @@ use crate::accel::isa::{Kernel, X86Level, dispatch};
 impl Grid {
     /// The closest hit along `ray`, if any.
     pub fn intersect(&self, ray: &Ray) -> Option<GridHit> {
-        self.intersect_counting(ray, &mut ())
+        self.ask(Intersect { ray, stats: () })
     }
 
     /// [`Grid::intersect`], reporting its work to `stats`.
@@ -31,7 +31,10 @@ impl Grid {
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<GridHit> {
-        self.ask(Intersect { ray, stats })
+        self.ask(Intersect {
+            ray,
+            stats: stats.lend(),
+        })
     }
 
     /// Runs `query` in the walk compiled for this grid: reaches per cell or per 2³ unit of
@@ -103,12 +106,15 @@ impl Grid {
 
     /// True when anything blocks `ray` within (`t_min`, `t_max`): for shadow rays.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.occluded_counting(ray, &mut ())
+        self.ask(Occluded { ray, stats: () })
     }
 
     /// [`Grid::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.ask(Occluded { ray, stats })
+        self.ask(Occluded {
+            ray,
+            stats: stats.lend(),
+        })
     }
 
     /// The cells are walked from the segment's far end back to its origin (the answer does
@@ -170,34 +176,35 @@ impl<Q: Query, const UNIT: u32, const BOXED: bool> Kernel for Asked<'_, Q, UNIT,
     }
 }
 
-/// The closest-hit query.
+/// The closest-hit query, with its counter by value (the unit type: no word at all), so
+/// that with the grid it is handed in two registers.
 struct Intersect<'a, S> {
     ray: &'a Ray,
-    stats: &'a mut S,
+    stats: S,
 }
 
 impl<S: TraversalStats> Query for Intersect<'_, S> {
     type Output = Option<GridHit>;
     #[inline(always)]
     fn run<const FUSED: bool, const UNIT: u32, const BOXED: bool>(
-        self,
+        mut self,
         grid: &Grid,
     ) -> Option<GridHit> {
-        grid.intersect_portable::<FUSED, UNIT, BOXED>(self.ray, self.stats)
+        grid.intersect_portable::<FUSED, UNIT, BOXED>(self.ray, &mut self.stats)
     }
 }
 
-/// The shadow query.
+/// The shadow query, its counter by value as [`Intersect`]'s.
 struct Occluded<'a, S> {
     ray: &'a Ray,
-    stats: &'a mut S,
+    stats: S,
 }
 
 impl<S: TraversalStats> Query for Occluded<'_, S> {
     type Output = bool;
     #[inline(always)]
-    fn run<const FUSED: bool, const UNIT: u32, const BOXED: bool>(self, grid: &Grid) -> bool {
-        grid.occluded_portable::<FUSED, UNIT, BOXED>(self.ray, self.stats)
+    fn run<const FUSED: bool, const UNIT: u32, const BOXED: bool>(mut self, grid: &Grid) -> bool {
+        grid.occluded_portable::<FUSED, UNIT, BOXED>(self.ray, &mut self.stats)
     }
 }
 
