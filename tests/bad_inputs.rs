@@ -56,6 +56,10 @@ const CASES: &[(&str, Expect)] = &[
         Expect::Error("requires unsupported glTF extension(s): EXT_teleport"),
     ),
     (
+        "animation_target_missing.gltf",
+        Expect::Error("animations[0].channels[0].target: node 99 does not exist (1 nodes)"),
+    ),
+    (
         "cyclic_nodes.gltf",
         Expect::Error("node hierarchy too deep or too large"),
     ),

@@ -470,3 +470,94 @@ fn images_do_not_depend_on_the_scene_scale() {
         assert_agree(&format!("room at scale {s} vs 1"), &reference, &at_scale);
     }
 }
+
+/// A glass ball whose metallic value comes from a texture (metallic factor 1, as glTF's
+/// default, times a texel of 0) is glass wherever the texture says so, though its factors
+/// alone say metal: one-sided as a loader makes such a material, it renders exactly as
+/// the same glass with a factor of 0, two-sided. (Classified by its factors, its inside
+/// was a one-sided metal's black back face and the ball rendered dark.)
+#[test]
+fn glass_made_by_a_metallic_texture_is_glass_inside_too() {
+    use gridtrace::scene::{ChannelRef, Texture, TextureRef};
+    let render = |textured: bool| {
+        let mut b = SceneBuilder::new();
+        let white = b.add_material(Material::diffuse("white", Vec3::splat(0.7)));
+        let light =
+            b.add_material(Material::diffuse("light", Vec3::ZERO).with_emission(Vec3::splat(4.0)));
+        let glass = if textured {
+            let zero = b.add_texture(Texture {
+                name: "metallic 0".into(),
+                width: 1,
+                height: 1,
+                texels: vec![[0, 65535, 0, 65535]],
+            });
+            let mut material = Material::new(
+                "textured glass",
+                Pbr {
+                    metallic: 1.0,
+                    ..Pbr::glass(1.5, Vec3::ONE)
+                },
+            );
+            material.textures.metallic = Some(ChannelRef {
+                texture: TextureRef::new(zero),
+                channel: 2,
+            });
+            material.double_sided = false;
+            material
+        } else {
+            Material::new("glass", Pbr::glass(1.5, Vec3::ONE))
+        };
+        let glass = b.add_material(glass);
+        let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+        add_quad(
+            &mut b,
+            [
+                v(-4., -1., -4.),
+                v(-4., -1., 4.),
+                v(4., -1., 4.),
+                v(4., -1., -4.),
+            ],
+            white,
+        );
+        add_quad(
+            &mut b,
+            [
+                v(-1., 3., -1.),
+                v(1., 3., -1.),
+                v(1., 3., 1.),
+                v(-1., 3., 1.),
+            ],
+            light,
+        );
+        add_sphere(&mut b, Vec3::ZERO, 0.8, glass);
+        let scene = b.build();
+        let settings = RenderSettings {
+            width: 32,
+            height: 32,
+            samples: 0..16,
+            ..Default::default()
+        };
+        Renderer::new(&scene)
+            .render(&camera_at(4.0, 40.0), &settings, &|| {})
+            .0
+    };
+    let (textured, constant) = (render(true), render(false));
+    // Below the ball's centre the floor is seen through it.
+    let through = |image: &Image| image.pixel(16, 20);
+    assert!(
+        through(&constant).min_element() > 0.005,
+        "the floor is not seen through constant glass: {}",
+        through(&constant)
+    );
+    let differing = (0..32 * 32)
+        .filter(|&i| textured.pixels[i] != constant.pixels[i])
+        .count();
+    assert_eq!(
+        differing,
+        0,
+        "textured glass renders differently from constant glass in {differing} pixels \
+         (means {} against {})",
+        textured.mean(),
+        constant.mean()
+    );
+}

@@ -212,7 +212,11 @@ impl Renderer<'_> {
                 let weight = emission_weight(arrival, strategy, light_pdf);
                 result.radiance += weight * beta * shading.emission;
             }
-            if depth == max_depth || (!front && !material.double_sided) {
+            // A one-sided surface's back is black, but for glass it is the inside of the
+            // volume. Whether this point is glass is read from the material as textured here
+            // (a glTF metallic texture can make a metal factor 0), not from its factors.
+            let two_sided = material.double_sided || shading.bsdf.transmits();
+            if depth == max_depth || (!front && !two_sided) {
                 break;
             }
 

@@ -93,7 +93,10 @@ impl Pbr {
         }
     }
 
-    /// True when light can pass through the surface (into a volume behind it).
+    /// True when light can pass through the surface (into a volume behind it), by the
+    /// constant factors alone: what loaders use to make constant glass two-sided. Textures
+    /// can change the answer point by point; the renderer asks the textured BSDF
+    /// ([`crate::render::Bsdf::transmits`]).
     pub fn transmits(&self) -> bool {
         self.transmission > 0.0 && self.metallic < 1.0
     }

@@ -95,6 +95,9 @@ def main():
     write_gltf("cyclic_nodes.gltf", document(nodes=[{"mesh": 0, "children": [1]}, {"children": [0]}]))
     deep = [{"children": [i + 1]} for i in range(999)] + [{"mesh": 0}]
     write_gltf("deep_nodes.gltf", document(nodes=deep))
+    # An animation channel whose target is a node the file does not have.
+    animation = {"samplers": [{"input": 1, "output": 0}], "channels": [{"sampler": 0, "target": {"node": 99, "path": "translation"}}]}
+    write_gltf("animation_target_missing.gltf", document(animations=[animation]))
 
     # Geometry that cannot be hit, or nothing to render.
     nan = float("nan")

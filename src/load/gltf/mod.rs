@@ -233,6 +233,19 @@ fn validate(document: &gltf::Document) -> Result<(), String> {
             _ => {}
         }
     }
+    // gltf-json checks a channel's sampler index but not its target's node, which the gltf
+    // crate unwraps when the animation is played.
+    for (a, animation) in root.animations.iter().enumerate() {
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let node = channel.target.node.value();
+            if node >= root.nodes.len() {
+                return Err(format!(
+                    "animations[{a}].channels[{c}].target: node {node} does not exist ({} nodes)",
+                    root.nodes.len()
+                ));
+            }
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         let path = path().to_string();

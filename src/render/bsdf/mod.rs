@@ -211,6 +211,12 @@ impl Bsdf {
         names
     }
 
+    /// True when light passes through the surface here (a glass lobe): its back face is
+    /// then the inside of a volume, whatever the material's sidedness.
+    pub fn transmits(&self) -> bool {
+        self.glass.is_some()
+    }
+
     /// True when every lobe is a delta (light sampling is useless there).
     pub fn is_delta(&self) -> bool {
         !self.has_cosine_lobes()
