@@ -739,3 +739,43 @@ fn a_killed_checkpointed_render_resumes_into_the_uninterrupted_image() {
         );
     }
 }
+
+/// A scene, a part to merge or an image to denoise named on the command line that is a
+/// FIFO is refused at once with the loader's own message for such files: opened, it would
+/// wait for a writer (merge and denoise forever, a render until the load timeout).
+#[test]
+fn files_named_on_the_command_line_that_are_not_regular_are_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["scene.glb", "part.exr"] {
+        let status = Command::new("mkfifo")
+            .arg(dir.path().join(name))
+            .status()
+            .expect("mkfifo runs");
+        assert!(status.success(), "mkfifo {name}");
+    }
+    let commands: [&[&str]; 4] = [
+        &["scene.glb", "-o", "out.exr"],
+        &["--inspect", "scene.glb"],
+        &["merge", "part.exr", "-o", "out.exr"],
+        &["denoise", "part.exr", "-o", "out.exr"],
+    ];
+    for args in commands {
+        let run = run_limited(args, dir.path());
+        let named = if args.contains(&"part.exr") {
+            "part.exr"
+        } else {
+            "scene.glb"
+        };
+        assert_eq!(run.code, Some(2), "{args:?}: {}", run.stderr);
+        assert_eq!(
+            run.stderr.trim(),
+            format!("error: '{named}' is a FIFO, not a regular file; refused"),
+            "{args:?}"
+        );
+        assert!(
+            run.elapsed < Duration::from_secs(10),
+            "{args:?}: {:?}",
+            run.elapsed
+        );
+    }
+}

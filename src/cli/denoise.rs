@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use super::args::DenoiseArgs;
 use super::signals::{check_output, write_last};
 use crate::limits::{check_memory, set_memory_budget};
+use crate::load::access::check_named_file;
 use crate::output::denoise::denoise;
 use crate::output::merge::read_part;
 use crate::render::Image;
@@ -42,6 +43,7 @@ pub fn denoise_for_output(image: &mut Image, threads: Option<u32>, quiet: bool) 
 pub fn run_denoise(args: &DenoiseArgs) -> Result<()> {
     set_memory_budget(args.max_memory.unwrap_or(0));
     check_output(&args.output)?;
+    check_named_file(&args.input)?;
     let part = read_part(&args.input)?;
     let (width, height) = (part.record.identity.width, part.record.identity.height);
     // The part's channels (at most 32 f32) and the image made of them.

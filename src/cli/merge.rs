@@ -8,6 +8,7 @@ use super::args::MergeArgs;
 use super::denoise::denoise_for_output;
 use super::signals::{check_output, write_last};
 use crate::limits::set_memory_budget;
+use crate::load::access::check_named_file;
 use crate::output::denoise::check_available;
 use crate::output::merge::merge_files;
 use crate::record::format_range;
@@ -19,6 +20,9 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
         check_available()?;
     }
     check_output(&args.output)?;
+    for part in &args.parts {
+        check_named_file(part)?;
+    }
     let start = Instant::now();
     let (mut image, mut record) = merge_files(&args.parts, args.samples.clone())?;
     if record.nonfinite > 0 {

@@ -221,6 +221,17 @@ pub fn read_regular_file(path: &Path, reference: &str, limit: u64) -> Result<Vec
     Ok(bytes)
 }
 
+/// Refuses a file named on the command line (a scene, a part to merge, an image to denoise)
+/// that is not a regular file — a FIFO would make its reader wait for a writer forever —
+/// without opening it. A path that cannot be looked at is left to the reader, whose message
+/// says why.
+pub fn check_named_file(path: &Path) -> Result<(), AccessError> {
+    match std::fs::metadata(path) {
+        Ok(metadata) => check_regular(&metadata, &path.display().to_string()),
+        Err(_) => Ok(()),
+    }
+}
+
 fn check_regular(metadata: &std::fs::Metadata, reference: &str) -> Result<(), AccessError> {
     let file_type = metadata.file_type();
     if file_type.is_file() {

@@ -12,6 +12,7 @@ use super::super::args::Args;
 use super::super::signals::{arm_load_timeout, check_output};
 use crate::limits::set_memory_budget;
 use crate::load::LoadOptions;
+use crate::load::access::check_named_file;
 use crate::output::Format;
 use crate::output::denoise::check_available;
 use crate::render::{AovSet, DEFAULT_SPP};
@@ -51,6 +52,7 @@ pub fn read_request(args: &Args) -> Result<Request<'_>> {
         .scene
         .as_deref()
         .ok_or_else(|| anyhow!("no scene file given"))?;
+    check_named_file(scene_path)?;
     let loading = &args.loading;
     let load_options = LoadOptions {
         gltf_light_units: loading.gltf_light_units.into(),
