@@ -260,7 +260,7 @@ impl LightSet {
         let Some(index) = self.triangles.index_of(instance, triangle) else {
             return 0.0;
         };
-        let pmf = self.tree.pmf(index, origin, origin_normal);
+        let pmf = || self.tree.pmf(index, origin, origin_normal);
         self.triangles
             .pdf(index, pmf, time, origin, distance, cos_light)
     }

@@ -262,12 +262,13 @@ impl EmissiveTriangles {
     }
 
     /// The solid-angle density with which [`EmissiveTriangles::sample`] at `origin`, having
-    /// chosen triangle `index` with probability `pmf`, would draw its point at `distance`
-    /// and light cosine `cos_light`, at shutter time `time`.
+    /// chosen triangle `index` with probability `pmf()`, would draw its point at `distance`
+    /// and light cosine `cos_light`, at shutter time `time`. `pmf` (a walk of the light
+    /// tree) is asked only when the triangle can have been sampled at all.
     pub fn pdf(
         &self,
         index: usize,
-        pmf: f32,
+        pmf: impl FnOnce() -> f32,
         time: f32,
         origin: Vec3,
         distance: f32,
@@ -276,7 +277,11 @@ impl EmissiveTriangles {
         let Some(placed) = self.placed_at(&self.triangles[index], time) else {
             return 0.0;
         };
-        if placed.area == 0.0 || cos_light == 0.0 || pmf == 0.0 {
+        if placed.area == 0.0 || cos_light == 0.0 {
+            return 0.0;
+        }
+        let pmf = pmf();
+        if pmf == 0.0 {
             return 0.0;
         }
         let omega = spherical::solid_angle(origin, placed.corners.map(|c| c.0));
