@@ -37,3 +37,4 @@ pub mod output;
 pub mod record;
 pub mod render;
 pub mod scene;
+pub mod terminal;

@@ -1,21 +1,88 @@
-//! The memory a run may use: one budget, checked before every allocation whose size comes
-//! from a file or an option (a film, a merged part, a decompressed mesh), so a hostile or
-//! mistaken input gets a clear error instead of an abort when the allocation fails.
+//! The memory a run may use: one budget for the whole process, against which every
+//! allocation whose size comes from a file or an option (a film, a merged part, a decoded
+//! image, a decompressed mesh) is checked before it is made, so a hostile or mistaken
+//! input gets a clear error instead of an abort when the allocation fails.
+//!
+//! The process's heap is accounted as it is used: the global allocator ([`Accounting`])
+//! keeps a running total of the bytes allocated, so a check compares a request with what
+//! is left — the budget minus everything already held, the copies made after earlier
+//! checks included — not with the whole budget.
 //!
 //! The budget is the smallest of 80 % of the machine's physical memory (the rest is the
-//! system's and the scene's) and the process's address-space and data-segment limits
-//! (`ulimit -v`, `ulimit -d`, `prlimit`), or what `--max-memory` says.
+//! system's), the process's address-space and data-segment limits (`ulimit -v`,
+//! `ulimit -d`, `prlimit`) less headroom for what the heap does not hold (code, thread
+//! stacks, the allocator's own reservations), or what `--max-memory` says.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 /// Set by `--max-memory`; 0 means "the machine's".
 static MAX_MEMORY: AtomicU64 = AtomicU64::new(0);
 
-/// An allocation larger than the budget, refused before it was made.
+/// Bytes the process holds on the heap now.
+static IN_USE: AtomicUsize = AtomicUsize::new(0);
+
+/// Bytes promised to work under way (a decode and the copies that follow it) and not yet
+/// all allocated: counted as held, so parallel work cannot take them too.
+static RESERVED: AtomicU64 = AtomicU64::new(0);
+
+/// The system allocator, counting what it hands out in [`IN_USE`].
+pub struct Accounting;
+
+// SAFETY: every call is passed to the system allocator unchanged; only a counter is kept.
+unsafe impl GlobalAlloc for Accounting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: the caller's contract is System's.
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            IN_USE.fetch_add(layout.size(), Ordering::Relaxed);
+        }
+        p
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: as above.
+        let p = unsafe { System.alloc_zeroed(layout) };
+        if !p.is_null() {
+            IN_USE.fetch_add(layout.size(), Ordering::Relaxed);
+        }
+        p
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: as above.
+        unsafe { System.dealloc(ptr, layout) };
+        IN_USE.fetch_sub(layout.size(), Ordering::Relaxed);
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        // SAFETY: as above.
+        let p = unsafe { System.realloc(ptr, layout, new_size) };
+        if !p.is_null() {
+            if new_size >= layout.size() {
+                IN_USE.fetch_add(new_size - layout.size(), Ordering::Relaxed);
+            } else {
+                IN_USE.fetch_sub(layout.size() - new_size, Ordering::Relaxed);
+            }
+        }
+        p
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Accounting = Accounting;
+
+/// Bytes the process holds on the heap now.
+pub fn memory_in_use() -> u64 {
+    IN_USE.load(Ordering::Relaxed) as u64
+}
+
+/// An allocation larger than what is left of the budget, refused before it was made.
 #[derive(Debug, thiserror::Error)]
 #[error(
-    "{what} needs {} of memory, more than the {} this run may use (--max-memory)",
+    "{what} needs {} of memory, more than the {} left of the {} this run may use (--max-memory)",
     Bytes(*needed),
+    Bytes(*left),
     Bytes(*budget)
 )]
 pub struct OverBudget {
@@ -23,6 +90,8 @@ pub struct OverBudget {
     pub what: String,
     /// Bytes it needs.
     pub needed: u64,
+    /// Bytes left when it was asked for.
+    pub left: u64,
     /// Bytes the run may use.
     pub budget: u64,
 }
@@ -32,7 +101,7 @@ pub fn set_memory_budget(bytes: u64) {
     MAX_MEMORY.store(bytes, Ordering::Relaxed);
 }
 
-/// Bytes this run may allocate in all.
+/// Bytes this run may hold in all.
 pub fn memory_budget() -> u64 {
     match MAX_MEMORY.load(Ordering::Relaxed) {
         0 => machine_memory(),
@@ -40,17 +109,55 @@ pub fn memory_budget() -> u64 {
     }
 }
 
-/// Refuses `needed` bytes for `what` if they exceed the budget.
+/// Bytes this run may still allocate: the budget less what the heap holds and what is
+/// reserved.
+pub fn memory_left() -> u64 {
+    memory_budget()
+        .saturating_sub(memory_in_use())
+        .saturating_sub(RESERVED.load(Ordering::Relaxed))
+}
+
+/// Refuses `needed` bytes for `what` if they exceed what is left of the budget.
 pub fn check_memory(what: impl FnOnce() -> String, needed: u64) -> Result<(), OverBudget> {
     let budget = memory_budget();
-    if needed > budget {
+    let left = memory_left();
+    if needed > left {
         return Err(OverBudget {
             what: what(),
             needed,
+            left,
             budget,
         });
     }
     Ok(())
+}
+
+/// Bytes set aside for a sequence of allocations (a decoder's output and the copies made
+/// from it) checked as one: released when dropped, by which time they are held or freed.
+#[must_use]
+pub struct Reservation(u64);
+
+impl Reservation {
+    /// The bytes reserved.
+    pub fn bytes(&self) -> u64 {
+        self.0
+    }
+}
+
+impl Drop for Reservation {
+    fn drop(&mut self) {
+        RESERVED.fetch_sub(self.0, Ordering::Relaxed);
+    }
+}
+
+/// Checks `needed` bytes for `what` and sets them aside until the reservation is dropped.
+pub fn reserve_memory(
+    what: impl FnOnce() -> String,
+    needed: u64,
+) -> Result<Reservation, OverBudget> {
+    check_memory(what, needed)?;
+    RESERVED.fetch_add(needed, Ordering::Relaxed);
+    Ok(Reservation(needed))
 }
 
 /// `count` items of `T` in bytes, saturating.
@@ -58,7 +165,15 @@ pub fn bytes_of<T>(count: u64) -> u64 {
     count.saturating_mul(std::mem::size_of::<T>() as u64)
 }
 
-/// 80 % of physical memory, capped by the process's address-space and data limits.
+/// What a process limit leaves the heap: the limit less an eighth of it, and at least
+/// 256 MiB, for the mappings the heap does not count (code, thread stacks, the allocator's
+/// per-thread arenas).
+fn heap_under(limit: u64) -> u64 {
+    limit.saturating_sub((limit / 8).max(256 << 20))
+}
+
+/// 80 % of physical memory, capped by what the process's address-space and data limits
+/// leave the heap.
 #[cfg(unix)]
 fn machine_memory() -> u64 {
     // SAFETY: sysconf and getrlimit only write to the struct passed by pointer.
@@ -79,7 +194,7 @@ fn machine_memory() -> u64 {
         // SAFETY: a valid resource and a valid pointer to write the limits to.
         let ok = unsafe { libc::getrlimit(resource, &mut rlimit) } == 0;
         if ok && rlimit.rlim_cur != libc::RLIM_INFINITY {
-            rlimit.rlim_cur
+            heap_under(rlimit.rlim_cur)
         } else {
             u64::MAX
         }
@@ -153,5 +268,23 @@ mod tests {
         assert!(budget > 1 << 20, "{budget}");
         let refused = check_memory(|| "a test".into(), u64::MAX).unwrap_err();
         assert!(refused.to_string().starts_with("a test needs"), "{refused}");
+    }
+
+    #[test]
+    fn what_is_held_is_counted_against_the_budget() {
+        let before = memory_in_use();
+        let held = vec![1u8; 64 << 20];
+        // Other tests allocate and free at the same time: allow them a margin.
+        assert!(memory_in_use() + (16 << 20) >= before + (64 << 20));
+        let left = memory_left();
+        assert!(left <= memory_budget() - (48 << 20), "{left}");
+        drop(held);
+    }
+
+    #[test]
+    fn a_process_limit_leaves_headroom_outside_the_heap() {
+        assert_eq!(heap_under(2 << 30), (2 << 30) - (256 << 20));
+        assert_eq!(heap_under(16 << 30), 14 << 30);
+        assert_eq!(heap_under(100 << 20), 0);
     }
 }

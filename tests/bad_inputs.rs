@@ -37,7 +37,7 @@ const CASES: &[(&str, Expect)] = &[
     ),
     (
         "index_out_of_range.gltf",
-        Expect::Error("index 9 is past the 4 vertices"),
+        Expect::Error("indices[5] is past the 4 vertices"),
     ),
     (
         "overlapping_stride.gltf",
@@ -112,7 +112,7 @@ const CASES: &[(&str, Expect)] = &[
     ("not_a_ply.ply", Expect::Error("bad PLY header")),
 ];
 
-/// Runs gridtrace on `scene`, failing the test if it takes longer than a minute.
+/// Runs gridtrace on `scene`, failing the test if it takes longer than three minutes.
 fn run(scene: &Path, out: &Path) -> (Option<i32>, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_gridtrace"))
         .arg(scene)
@@ -130,7 +130,7 @@ fn run(scene: &Path, out: &Path) -> (Option<i32>, String) {
         .unwrap();
     let start = Instant::now();
     while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(60) {
+        if start.elapsed() > Duration::from_secs(180) {
             child.kill().unwrap();
             panic!("{}: gridtrace hung", scene.display());
         }

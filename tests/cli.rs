@@ -265,6 +265,7 @@ fn help_explains_every_option() {
 #[test]
 fn ctrl_c_stops_after_the_current_pass_and_writes_the_image_so_far() {
     let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("stderr.txt");
     let child = Command::new(env!("CARGO_BIN_EXE_gridtrace"))
         .args([
             &asset("cornell_box.glb"),
@@ -274,20 +275,28 @@ fn ctrl_c_stops_after_the_current_pass_and_writes_the_image_so_far() {
             "64",
             "--spp",
             "1000000",
-            "-q",
         ])
         .current_dir(dir.path())
-        .stderr(std::process::Stdio::piped())
+        .stderr(std::fs::File::create(&log).unwrap())
         .spawn()
         .unwrap();
-    // Let a few passes finish, then interrupt as a terminal's Ctrl-C would.
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let child = binary::Owned::new(child);
+    // Once rendering has begun, interrupt as a terminal's Ctrl-C would.
+    assert!(
+        binary::wait_for_text(&log, "prepared in", std::time::Duration::from_secs(180)),
+        "the render never started"
+    );
     let killed = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
         .unwrap();
     assert!(killed.success());
-    let out = child.wait_with_output().unwrap();
+    let status = child.release().wait().unwrap();
+    let out = std::process::Output {
+        status,
+        stdout: Vec::new(),
+        stderr: std::fs::read(&log).unwrap(),
+    };
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(130), "{err}");
     assert!(

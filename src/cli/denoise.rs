@@ -19,21 +19,21 @@ pub fn denoise_for_output(image: &mut Image, threads: Option<u32>, quiet: bool) 
         (Some(_), Some(_)) => "albedo and normal",
         (Some(_), None) => "albedo",
         _ => {
-            eprintln!(
+            crate::terminal::say(format_args!(
                 "warning: the image has no albedo and normal layers; denoising the beauty \
                  alone keeps less detail (render with --denoise or --aov albedo,normal)"
-            );
+            ));
             "nothing"
         }
     };
     denoise(image, threads.unwrap_or(0) as usize)?;
     if !quiet {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "denoised {}x{} guided by {guides} in {:.2} s",
             image.width,
             image.height,
             start.elapsed().as_secs_f64()
-        );
+        ));
     }
     Ok(())
 }
@@ -59,7 +59,7 @@ pub fn run_denoise(args: &DenoiseArgs) -> Result<()> {
     record.denoised = true;
     write_last(&args.output, &image, &record, args.view_transform.into())?;
     if !args.quiet {
-        eprintln!("wrote {}", args.output.display());
+        crate::terminal::say(format_args!("wrote {}", args.output.display()));
     }
     Ok(())
 }

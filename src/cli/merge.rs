@@ -26,10 +26,10 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
     let start = Instant::now();
     let (mut image, mut record) = merge_files(&args.parts, args.samples.clone())?;
     if record.nonfinite > 0 {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "warning: {} sample(s) were NaN or infinite and were dropped",
             record.nonfinite
-        );
+        ));
     }
     if args.denoise {
         denoise_for_output(&mut image, args.threads, args.quiet)?;
@@ -37,7 +37,7 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
     }
     write_last(&args.output, &image, &record, args.view_transform.into())?;
     if !args.quiet {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "merged {} part(s) of {} ({}x{}, camera {}): samples {} in {:.2} s; wrote {}",
             args.parts.len(),
             record.scene_name,
@@ -47,7 +47,7 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
             format_range(&record.samples),
             start.elapsed().as_secs_f64(),
             args.output.display()
-        );
+        ));
     }
     Ok(())
 }

@@ -43,7 +43,7 @@ pub fn main() -> i32 {
         Ok(Outcome::Completed) => 0,
         Ok(Outcome::Interrupted) => signals::interrupted_exit_code(),
         Err(e) => {
-            eprintln!("error: {e:#}");
+            crate::terminal::say(format_args!("error: {e:#}"));
             2
         }
     }

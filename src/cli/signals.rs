@@ -102,10 +102,10 @@ pub fn arm_load_timeout(limit: Duration, scene: &Path) {
         std::thread::sleep(limit);
         let _writing = output_lock();
         if PHASE.load(Ordering::SeqCst) == Phase::Preparing as u8 {
-            eprintln!(
+            crate::terminal::say(format_args!(
                 "error: {scene}: loading did not finish within {} s (--load-timeout); a reader may be looping on this file",
                 limit.as_secs_f64()
-            );
+            ));
             std::process::exit(2);
         }
     });
@@ -114,7 +114,9 @@ pub fn arm_load_timeout(limit: Duration, scene: &Path) {
 /// Installs the handlers: a thread that waits for the signals and acts on them.
 pub fn install() {
     let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
-        eprintln!("warning: cannot install signal handlers; Ctrl-C will not save the image");
+        crate::terminal::say(format_args!(
+            "warning: cannot install signal handlers; Ctrl-C will not save the image"
+        ));
         return;
     };
     std::thread::spawn(move || {
@@ -132,9 +134,9 @@ fn on_signal(signal: i32) {
     let rendering = PHASE.load(Ordering::SeqCst) == Phase::Rendering as u8;
     if first && rendering {
         STOP.store(true, Ordering::SeqCst);
-        eprintln!(
+        crate::terminal::say(format_args!(
             "\n{name}: finishing the current pass, then writing the image (a second signal quits without writing)"
-        );
+        ));
         return;
     }
     // Quit, but never half-way through writing a file.
@@ -142,10 +144,10 @@ fn on_signal(signal: i32) {
     let code = 128 + SIGNAL.load(Ordering::SeqCst);
     match PHASE.load(Ordering::SeqCst) {
         p if p == Phase::Finished as u8 => {}
-        p if p == Phase::Rendering as u8 => {
-            eprintln!("\n{name} again: quitting without writing the image")
-        }
-        _ => eprintln!("\n{name}: quitting before rendering"),
+        p if p == Phase::Rendering as u8 => crate::terminal::say(format_args!(
+            "\n{name} again: quitting without writing the image"
+        )),
+        _ => crate::terminal::say(format_args!("\n{name}: quitting before rendering")),
     }
     std::process::exit(code);
 }

@@ -3,7 +3,7 @@
 //! widened to 16-bit RGBA; Radiance HDR and OpenEXR
 //! latitude–longitude maps into linear float [`EnvironmentMap`]s.
 
-use crate::limits::{check_memory, memory_budget};
+use crate::limits::{Reservation, check_memory, reserve_memory};
 use crate::load::guard::catching_panics;
 use crate::scene::{EnvironmentMap, Texture, srgb_to_linear};
 
@@ -15,7 +15,9 @@ pub fn decode_texture(name: String, bytes: &[u8]) -> Result<Texture, String> {
     if bytes.starts_with(KTX2_MAGIC) {
         return decode_basis(name, bytes);
     }
-    let rgba = decode(bytes)?.to_rgba16();
+    let (decoded, _reserved) = decode(bytes, TEXTURE_BYTES_PER_TEXEL)?;
+    let rgba = decoded.to_rgba16();
+    drop(decoded);
     let (width, height) = rgba.dimensions();
     Ok(Texture {
         name,
@@ -24,6 +26,15 @@ pub fn decode_texture(name: String, bytes: &[u8]) -> Result<Texture, String> {
         texels: rgba.pixels().map(|p| p.0).collect(),
     })
 }
+
+/// Most bytes a texel takes on its way to a [`Texture`]: the decoder's output (at most
+/// 32-bit float RGBA, 16 bytes), the 16-bit RGBA conversion (8) and the texels kept (8),
+/// reserved together before decoding so no copy after the check can exceed the budget.
+const TEXTURE_BYTES_PER_TEXEL: u64 = 16 + 8 + 8;
+
+/// The same for an [`EnvironmentMap`]: the decoder's output (16), the float RGB
+/// conversion (12) and the texels kept (12).
+const ENVIRONMENT_BYTES_PER_TEXEL: u64 = 16 + 12 + 12;
 
 /// The first bytes of every KTX 2.0 file (KTX 2.0 §3.1).
 const KTX2_MAGIC: &[u8] = b"\xabKTX 20\xbb\r\n\x1a\n";
@@ -126,13 +137,14 @@ fn check_ktx2_header(bytes: &[u8]) -> Result<(), String> {
 /// format [`decode_texture`] reads, taken as sRGB) as linear RGB radiance named `name`.
 /// Negative values (from image processing) become zero; a NaN or infinite value is an error.
 pub fn decode_environment(name: String, bytes: &[u8]) -> Result<EnvironmentMap, String> {
-    let decoded = decode(bytes)?;
+    let (decoded, _reserved) = decode(bytes, ENVIRONMENT_BYTES_PER_TEXEL)?;
     // Float images hold linear radiance; 8- and 16-bit ones are sRGB-encoded pictures.
     let linear = matches!(
         decoded.color(),
         image::ColorType::Rgb32F | image::ColorType::Rgba32F
     );
     let rgb = decoded.to_rgb32f();
+    drop(decoded);
     let (width, height) = rgb.dimensions();
     if width == 0 || height == 0 {
         return Err("is empty".into());
@@ -155,16 +167,39 @@ pub fn decode_environment(name: String, bytes: &[u8]) -> Result<EnvironmentMap, 
     })
 }
 
-/// Decodes `bytes`, the format guessed from their first bytes, refusing images whose pixels
-/// would not fit in the memory budget before allocating them.
-fn decode(bytes: &[u8]) -> Result<image::DynamicImage, String> {
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| format!("cannot be decoded ({e})"))?;
+/// Decodes `bytes`, the format guessed from their first bytes. The header's size is read
+/// first and `bytes_per_texel` for every pixel reserved from the budget (the decode and the
+/// caller's copies of it), so an image too large for memory is refused before anything is
+/// allocated; the decoder itself is held to the reservation by `image`'s limits.
+fn decode(
+    bytes: &[u8],
+    bytes_per_texel: u64,
+) -> Result<(image::DynamicImage, Reservation), String> {
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| format!("cannot be decoded ({e})"))
+    };
+    let (width, height) = catching_panics(|| {
+        reader()?
+            .into_dimensions()
+            .map_err(|e| format!("cannot be decoded ({e})"))
+    })
+    .map_err(|why| format!("cannot be decoded (the decoder failed: {why})"))??;
+    let texels = u64::from(width) * u64::from(height);
+    let reserved = reserve_memory(
+        || format!("decoding its {width}x{height} pixels"),
+        texels.saturating_mul(bytes_per_texel),
+    )
+    .map_err(|e| format!("is too large: {e}"))?;
+    let mut reader = reader()?;
     let mut limits = image::Limits::default();
-    limits.max_alloc = Some(memory_budget());
+    limits.max_image_width = Some(width);
+    limits.max_image_height = Some(height);
+    limits.max_alloc = Some(reserved.bytes());
     reader.limits(limits);
-    catching_panics(|| reader.decode())
+    let decoded = catching_panics(|| reader.decode())
         .map_err(|why| format!("cannot be decoded (the decoder failed: {why})"))?
-        .map_err(|e| format!("cannot be decoded ({e})"))
+        .map_err(|e| format!("cannot be decoded ({e})"))?;
+    Ok((decoded, reserved))
 }

@@ -216,7 +216,7 @@ pub fn load_environment(path: &Path) -> Result<Environment, LoadError> {
 pub fn load_environment_map(path: &Path) -> Result<EnvironmentMap, LoadError> {
     let name = path.display().to_string();
     let bytes =
-        access::read_regular_file(path, &name, crate::limits::memory_budget()).map_err(|e| {
+        access::read_regular_file(path, &name, crate::limits::memory_left()).map_err(|e| {
             LoadError::Invalid {
                 path: path.to_path_buf(),
                 what: e.to_string(),

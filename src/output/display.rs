@@ -177,7 +177,9 @@ impl LiveView {
             .iter()
             .try_for_each(|packet| stream.write_all(packet));
         if let Err(e) = sent {
-            eprintln!("warning: the live view was lost ({e}); rendering goes on");
+            crate::terminal::say(format_args!(
+                "warning: the live view was lost ({e}); rendering goes on"
+            ));
             self.stream = None;
         }
         self.last = Some(Instant::now());

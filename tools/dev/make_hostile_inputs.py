@@ -18,7 +18,9 @@ import os
 import random
 import struct
 import sys
+import warnings
 import zipfile
+import zlib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -358,6 +360,115 @@ def Xform "B" (
     doc = gltf()
     doc["accessors"][0]["count"] = 2**62 + 1
     write_json(j("count_overflow.gltf"), doc)
+
+    make_memory_text_and_silent_cases(j)
+
+
+def grey_png(width, height):
+    """A grey PNG of zeros, `width`×`height`: a few hundred kilobytes that decode to
+    `width`·`height` bytes (and to 32 bytes a pixel on the way to a texture)."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    compress = zlib.compressobj(9)
+    row = bytes(width + 1)  # filter byte 0, then the row
+    idat = b"".join(compress.compress(row) for _ in range(height)) + compress.flush()
+    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", idat) + chunk(b"IEND", b"")
+
+
+def rle_hdr(width, height):
+    """A Radiance .hdr of `width`×`height` black pixels in new-style run-length scanlines
+    (Ward, Graphics Gems II): a few megabytes that decode to 12 bytes a pixel."""
+    header = f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n".encode()
+    runs = bytearray()
+    for _ in range(4):  # R, G, B, E, each a channel of runs of 127 zeros
+        left = width
+        while left:
+            n = min(127, left)
+            runs += bytes([128 + n, 0])
+            left -= n
+    line = bytes([2, 2, width >> 8, width & 255]) + bytes(runs)
+    return header + line * height
+
+
+def flat_hdr(width, height):
+    """A Radiance .hdr of grey pixels stored flat (4 bytes each, no run-length coding)."""
+    header = f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n".encode()
+    return header + bytes([128, 128, 128, 129]) * (width * height)
+
+
+def textured_gltf(uri):
+    """The quad with a base colour texture read from `uri`."""
+    doc = gltf()
+    doc["images"] = [{"uri": uri}]
+    doc["textures"] = [{"source": 0}]
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+    return doc
+
+
+def make_memory_text_and_silent_cases(j):
+    """Memory for the whole process, decompression bombs, text that would reach a
+    terminal, and results that would be silently wrong."""
+    # Buffers that meshopt decodes into are zeros of their byteLength: two of 2.5 GB.
+    doc = gltf()
+    fallback = {"byteLength": 5 << 29, "extensions": {"EXT_meshopt_compression": {"fallback": True}}}
+    doc["buffers"] += [dict(fallback), dict(fallback)]
+    doc["extensionsUsed"] = ["EXT_meshopt_compression"]
+    write_json(j("meshopt_huge_fallback.gltf"), doc)
+    # An accessor without a buffer view is zeros of its count.
+    doc = gltf()
+    del doc["accessors"][0]["bufferView"]
+    doc["accessors"][0]["count"] = 300_000_000
+    write_json(j("zero_filled_positions.gltf"), doc)
+    # Image bombs: a 12000² grey PNG (about 150 kB) as a texture, in a .gltf and a .usdz.
+    write(j("bomb.png"), grey_png(12000, 12000))
+    write_json(j("png_bomb.gltf"), textured_gltf("bomb.png"))
+    with zipfile.ZipFile(j("usdz_png_bomb.usdz"), "w") as z:
+        z.writestr("root.usda", usda(textured_material("Bomb", "bomb.png")).replace("</Glow>", "</Bomb>", 1))
+        z.write(j("bomb.png"), "bomb.png")
+    # One image spelt four ways decodes once (tests/hostile.rs counts the textures).
+    os.makedirs(j("sub"), exist_ok=True)
+    write(j("t.png"), grey_png(4, 4))
+    doc = textured_gltf("t.png")
+    doc["images"] = [{"uri": u} for u in ["t.png", "./t.png", "sub/../t.png", "%74.png"]]
+    doc["textures"] = [{"source": i} for i in range(4)]
+    doc["materials"] = [dict(doc["materials"][0], pbrMetallicRoughness={"baseColorTexture": {"index": i}}) for i in range(4)]
+    doc["meshes"] = [{"primitives": [dict(doc["meshes"][0]["primitives"][0], material=i)]} for i in range(4)]
+    doc["nodes"] = [{"mesh": i} for i in range(4)]
+    doc["scenes"] = [{"nodes": [0, 1, 2, 3]}]
+    write_json(j("texture_aliases.gltf"), doc)
+    # An environment map of 12000×6000 in 4.6 MB, and one cut short after 600 bytes.
+    write(j("big_rle.hdr"), rle_hdr(12000, 6000))
+    write(j("cut.hdr"), flat_hdr(64, 32)[:600])
+    dome = """def DomeLight "Sky"
+{
+    asset inputs:texture:file = @big_rle.hdr@
+}
+"""
+    write(j("usd_dome_bomb.usda"), usda(dome))
+    # Control characters in names and URIs from the file.
+    doc = gltf()
+    doc["meshes"][0]["name"] = "quad\x1b[2J\nerror: forged second line"
+    doc["accessors"][1]["count"] = 7  # reads past its view: an error naming the mesh
+    write_json(j("escape_in_name.gltf"), doc)
+    write_json(j("escape_in_uri.gltf"), textured_gltf("\x1b]0;owned\x07missing.png"))
+    # Clipping that would hide everything.
+    write_json(j("camera_near_beyond_far.gltf"), with_camera(
+        {"type": "perspective", "perspective": {"yfov": 0.8, "znear": 10, "zfar": 1}}))
+    write(j("usd_reversed_clipping.usda"), usda("""def Camera "Cam"
+{
+    float2 clippingRange = (100, 0.1)
+    double3 xformOp:translate = (0, 0, 3)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+}
+"""))
+    # Packages: two members of one name, a member in a method usdz does not allow.
+    with zipfile.ZipFile(j("usdz_twin_members.usdz"), "w") as z, warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "Duplicate name": the point of the case
+        z.writestr("scene.usda", usda())
+        z.writestr("scene.usda", usda(metadata="    subLayers = [@../secret.usda@]\n"))
+    with zipfile.ZipFile(j("usdz_bzip2_member.usdz"), "w") as z:
+        z.writestr(zipfile.ZipInfo("scene.usda"), usda(), compress_type=zipfile.ZIP_BZIP2)
 
 
 def exr_claiming(part, size, out):

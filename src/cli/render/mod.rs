@@ -25,7 +25,7 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     if args.inspect {
         let report = prepare::describe_for_inspection(args, &request)?;
         set_phase(Phase::Finished);
-        print!("{}:\n{report}", request.scene_path.display());
+        crate::terminal::print_report(&format!("{}:\n{report}", request.scene_path.display()));
         return Ok(Outcome::Completed);
     }
     let plan = plan::plan_outputs(args, request)?;

@@ -121,7 +121,9 @@ pub fn render_passes(
             settings.height,
         )
         .unwrap_or_else(|e| {
-            eprintln!("warning: --display {address}: {e}; rendering without a live view");
+            crate::terminal::say(format_args!(
+                "warning: --display {address}: {e}; rendering without a live view"
+            ));
             LiveView::disconnected()
         })
     });

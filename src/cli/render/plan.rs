@@ -107,16 +107,16 @@ pub fn plan_outputs<'a>(args: &Args, request: Request<'a>) -> Result<Plan<'a>> {
     check_output(&output)?;
     let is_exr = Format::from_path(&output)? == Format::Exr;
     if sampling.samples.is_some() && !is_exr {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "warning: {}: only .exr parts can be merged; a PNG keeps no record of its samples",
             output.display()
-        );
+        ));
     }
     if image.aov.is_some() && !is_exr {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "warning: {}: a PNG holds the beauty only; --aov layers are written into .exr files",
             output.display()
-        );
+        ));
     }
     Ok(Plan {
         request,

@@ -86,7 +86,7 @@ pub fn prepare(args: &Args, plan: &Plan) -> Result<Prepared> {
     let dependencies_sha256 = sha256_files(folder_of(scene_path), &loaded.files)
         .context("hashing the files the scene reads")?;
     for warning in &loaded.warnings {
-        eprintln!("warning: {warning}");
+        crate::terminal::say(format_args!("warning: {warning}"));
     }
     let mut scene = loaded.scene;
     let environment = apply_environment(&mut scene, &args.world)?;
@@ -122,17 +122,17 @@ fn check_contents(
         );
     }
     if triangles == 0 {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "warning: {}: the scene has no triangles; the image will be empty",
             scene_path.display()
-        );
+        ));
     } else if environment.source == EnvironmentSource::Studio {
-        eprintln!("{}", studio_note(scene_path));
+        crate::terminal::say(format_args!("{}", studio_note(scene_path)));
     } else if !scene.has_emitters() {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "warning: {}: the scene has no emitters (no emissive material, no light, no environment); the image will be black",
             scene_path.display()
-        );
+        ));
     }
     Ok(())
 }
@@ -170,9 +170,9 @@ fn frame(
     if let (Some(w), Some(h), Some(aspect)) = (view.width, view.height, camera.aspect_ratio())
         && ((w as f32 / h as f32) / aspect - 1.0).abs() > 0.01
     {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "note: {w}x{h} does not match the camera's aspect ratio {aspect:.3}; keeping its vertical field of view"
-        );
+        ));
     }
     let filter = sampling.filter.into();
     let settings = RenderSettings {

@@ -19,7 +19,7 @@ use crate::render::{EarlyEnd, RenderStats, Renderer};
 pub fn prepared(plan: &Plan, prepared: &Prepared, renderer: &Renderer, took: Duration) {
     let scene = &prepared.scene;
     let camera = &prepared.camera;
-    eprintln!(
+    crate::terminal::say(format_args!(
         "{}: {} triangles in {} instances, {} emissive, {} punctual light(s); camera {}; \
          prepared in {:.2} s",
         plan.request.scene_path.display(),
@@ -33,7 +33,7 @@ pub fn prepared(plan: &Plan, prepared: &Prepared, renderer: &Renderer, took: Dur
             &camera.name
         },
         took.as_secs_f64()
-    );
+    ));
 }
 
 /// Says how the render ended, denoises if asked, writes the output and the summary.
@@ -51,7 +51,9 @@ pub fn finish(
         checkpoint_error,
     } = rendered;
     if let Some(e) = checkpoint_error {
-        eprintln!("warning: a checkpoint could not be written: {e}");
+        crate::terminal::say(format_args!(
+            "warning: a checkpoint could not be written: {e}"
+        ));
     }
     tell_how_it_ended(args, prepared, &image, &stats);
     if let Some(view) = &mut display {
@@ -72,7 +74,7 @@ pub fn finish(
             Some(_) => format!(" (samples {})", format_range(&image.samples())),
             None => String::new(),
         };
-        eprintln!(
+        crate::terminal::say(format_args!(
             "rendered {}x{} at {} spp{range} in {seconds:.2} s: {:.2} M samples/s, {:.2} M rays/s; wrote {}",
             image.width,
             image.height,
@@ -80,7 +82,7 @@ pub fn finish(
             stats.samples as f64 / seconds / 1e6,
             stats.rays as f64 / seconds / 1e6,
             plan.output.display()
-        );
+        ));
     }
     Ok(match stats.ended_early {
         Some(EarlyEnd::Stopped) => Outcome::Interrupted,
@@ -104,31 +106,31 @@ fn tell_how_it_ended(
         _ => None,
     };
     if let Some(why) = why {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "{why} after {} of at most {} passes ({:.2} samples per pixel on average)",
             stats.spp,
             settings.spp(),
             stats.samples as f64 / pixels
-        );
+        ));
     } else if settings.noise_threshold.is_some() && !args.image.quiet {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "adaptive sampling took {:.2} samples per pixel on average ({} at most)",
             stats.samples as f64 / pixels,
             stats.spp
-        );
+        ));
     }
     if stats.ended_early == Some(EarlyEnd::Stopped) {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "stopped after {} of {} samples per pixel (samples {}); writing the image so far",
             stats.spp,
             settings.spp(),
             format_range(&image.samples())
-        );
+        ));
     }
     if stats.nonfinite > 0 {
-        eprintln!(
+        crate::terminal::say(format_args!(
             "warning: {} sample(s) were NaN or infinite and were dropped",
             stats.nonfinite
-        );
+        ));
     }
 }

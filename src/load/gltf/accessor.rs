@@ -114,7 +114,10 @@ fn read_with<T: Copy + Default>(
             .map_err(|why| format!("accessor {} {why}", accessor.index()))?;
             Some((bytes, stride))
         }
-        None => None,
+        None => {
+            check_zero_filled(accessor, buffers)?;
+            None
+        }
     };
     let total = (count as u64).saturating_mul(layout.components() as u64);
     check_memory(
@@ -161,7 +164,7 @@ fn read_with<T: Copy + Default>(
             let target = component(index_type, &index_bytes[k * index_size..]) as usize;
             if target >= count {
                 return Err(what(format!(
-                    "substitutes element {target}, past its {count} elements"
+                    "sparse index {k} substitutes an element past its {count} elements"
                 )));
             }
             let out = &mut values[target * layout.components()..(target + 1) * layout.components()];
@@ -169,6 +172,30 @@ fn read_with<T: Copy + Default>(
         }
     }
     Ok(values)
+}
+
+/// Fewest elements an accessor without a buffer view may always have.
+const ZERO_FILLED_FLOOR: usize = 1 << 16;
+
+/// Refuses an accessor without a buffer view (all zeros but for its sparse substitutes,
+/// glTF 2.0 §3.6.2.3) holding more elements than the file's buffers hold bytes (and more
+/// than [`ZERO_FILLED_FLOOR`]): every element that matters is set by sparse data or named
+/// by an index, each taking at least a byte of some buffer, so a larger count only makes
+/// a tiny file allocate without bound.
+fn check_zero_filled(
+    accessor: &gltf::Accessor,
+    buffers: &[gltf::buffer::Data],
+) -> Result<(), String> {
+    let held: usize = buffers.iter().map(|b| b.0.len()).sum();
+    let most = held.max(ZERO_FILLED_FLOOR);
+    if accessor.count() > most {
+        return Err(format!(
+            "accessor {} has no buffer view and {} elements, more than the {most} its file's buffers could set",
+            accessor.index(),
+            accessor.count()
+        ));
+    }
+    Ok(())
 }
 
 /// Where an accessor's components sit inside one element.

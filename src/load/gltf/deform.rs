@@ -100,8 +100,7 @@ fn skin(
                 }
                 let joint = joints.get(j[k] as usize).ok_or_else(|| {
                     format!(
-                        "JOINTS_{set} names joint {}, past the skin's {}",
-                        j[k],
+                        "JOINTS_{set} of vertex {v} names a joint past the skin's {}",
                         joints.len()
                     )
                 })?;

@@ -11,7 +11,7 @@ use std::collections::HashMap;
 use draco_core::{DecodeLimits, DecoderBuffer, Mesh, MeshDecoder};
 
 use super::accessor::{Elements, normalize_as};
-use crate::limits::memory_budget;
+use crate::limits::memory_left;
 use crate::load::guard::catching_panics;
 
 /// The extension's name.
@@ -57,7 +57,7 @@ pub(super) fn decode(
             buffer.len()
         ))?;
     let defaults = DecodeLimits::default();
-    let limits = defaults.with_max_decoded_bytes(defaults.max_decoded_bytes.min(memory_budget()));
+    let limits = defaults.with_max_decoded_bytes(defaults.max_decoded_bytes.min(memory_left()));
     let mut mesh = Mesh::new();
     catching_panics(|| {
         MeshDecoder::new().decode(

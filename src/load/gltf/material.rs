@@ -327,9 +327,20 @@ impl GltfLoader {
         })
     }
 
-    /// The scene texture of a glTF image, decoded on first use.
+    /// The scene texture of a glTF image, decoded on first use: once per image, and once
+    /// per file however its URI is spelt (`t.png`, `./t.png`, `%74.png`).
     pub(super) fn image_texture(&mut self, image: &gltf::Image) -> Option<usize> {
         if let Some(&known) = self.images.get(&image.index()) {
+            return known;
+        }
+        let file = match image.source() {
+            gltf::image::Source::Uri { uri, .. } if !is_data_uri(uri) => {
+                self.files.resolve(uri).ok()
+            }
+            _ => None,
+        };
+        if let Some(&known) = file.as_ref().and_then(|f| self.image_files.get(f)) {
+            self.images.insert(image.index(), known);
             return known;
         }
         let name = image.name().map_or_else(
@@ -350,6 +361,9 @@ impl GltfLoader {
             }
         };
         self.images.insert(image.index(), decoded);
+        if let Some(file) = file {
+            self.image_files.insert(file, decoded);
+        }
         decoded
     }
 

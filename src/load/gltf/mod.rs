@@ -106,6 +106,7 @@ pub fn load_bytes_with(
         default_material: None,
         light_units: options.gltf_light_units,
         images: HashMap::new(),
+        image_files: HashMap::new(),
         missing_images: HashSet::new(),
         normal_mapped: Vec::new(),
         coloured_materials: HashSet::new(),
@@ -277,6 +278,8 @@ struct GltfLoader {
     light_units: GltfLightUnits,
     /// Our texture index for each glTF image tried so far (`None`: unusable).
     images: HashMap<usize, Option<usize>>,
+    /// The same for each image file, by its canonical path.
+    image_files: HashMap<PathBuf, Option<usize>>,
     /// Images whose external file cannot be read (already warned about).
     missing_images: HashSet<usize>,
     /// For each glTF material: the texture-coordinate set its normal map uses, if any.
@@ -385,13 +388,14 @@ impl GltfLoader {
     fn add_camera(&mut self, camera: &gltf::Camera, world: Mat4, source: &str) {
         // Scale in a camera's node would distort distances; keep rotation and translation.
         let (_, rotation, translation) = world.to_scale_rotation_translation();
-        let (projection, znear) = match camera.projection() {
+        let (projection, znear, zfar) = match camera.projection() {
             gltf::camera::Projection::Perspective(p) => (
                 Projection::Perspective {
                     yfov: p.yfov(),
                     aspect_ratio: p.aspect_ratio(),
                 },
                 p.znear(),
+                p.zfar(),
             ),
             gltf::camera::Projection::Orthographic(o) => (
                 Projection::Orthographic {
@@ -399,7 +403,19 @@ impl GltfLoader {
                     ymag: o.ymag().abs(),
                 },
                 o.znear(),
+                Some(o.zfar()),
             ),
+        };
+        // glTF requires zfar > znear (§5.13.1); a reversed pair would clip everything.
+        let znear = match zfar {
+            Some(zfar) if zfar < znear => {
+                self.warn(format!(
+                    "{source}: camera {}: znear {znear} is beyond zfar {zfar}; clipping from {zfar} instead",
+                    camera.index()
+                ));
+                zfar
+            }
+            _ => znear,
         };
         self.builder.add_camera(Camera {
             name: camera.name().unwrap_or_default().to_string(),

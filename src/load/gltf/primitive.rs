@@ -124,9 +124,11 @@ impl GltfLoader {
             Some(indices) => indices,
             None => (0..positions.len() as u32).collect(),
         };
-        if let Some(&bad) = corners.iter().find(|&&i| i as usize >= positions.len()) {
+        // The position, not the value: a buffer's bytes never reach a message (the file
+        // may be a hard link to one the scene's author could not otherwise show).
+        if let Some(bad) = corners.iter().position(|&i| i as usize >= positions.len()) {
             return Err(invalid(format!(
-                "index {bad} is past the {} vertices",
+                "indices[{bad}] is past the {} vertices",
                 positions.len()
             )));
         }

@@ -16,10 +16,19 @@ impl UsdLoader {
         let focal = self.get_f32(prim, "focalLength").unwrap_or(50.0);
         let horizontal = self.get_f32(prim, "horizontalAperture").unwrap_or(20.955);
         let vertical = self.get_f32(prim, "verticalAperture").unwrap_or(15.2908);
-        let znear = match self.get(prim, "clippingRange") {
-            Some(sdf::Value::Vec2f(r)) => r.x,
-            Some(sdf::Value::Vec2d(r)) => r.x as f32,
-            _ => 1.0,
+        let (znear, zfar) = match self.get(prim, "clippingRange") {
+            Some(sdf::Value::Vec2f(r)) => (r.x, r.y),
+            Some(sdf::Value::Vec2d(r)) => (r.x as f32, r.y as f32),
+            _ => (1.0, 1e6),
+        };
+        // A reversed range (near beyond far) would clip everything.
+        let znear = if zfar < znear {
+            self.warn(format!(
+                "{where_}: clippingRange ({znear}, {zfar}) is reversed; clipping from {zfar} instead"
+            ));
+            zfar
+        } else {
+            znear
         };
         let (scale, rotation, translation) = world.to_scale_rotation_translation();
         let projection = if self.get_token(prim, "projection").as_deref() == Some("orthographic") {

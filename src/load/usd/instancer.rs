@@ -13,7 +13,7 @@ use openusd::{sdf, usd};
 
 use super::UsdLoader;
 use super::value::{as_ints, as_vec3s};
-use crate::limits::memory_budget;
+use crate::limits::memory_left;
 use crate::load::LoadError;
 use crate::scene::Instance;
 
@@ -59,7 +59,7 @@ impl UsdLoader {
         let orientations = self.orientations(&path, count, &where_);
         let scales = self.optional_per_instance(&path, "scales", count, &where_);
         let hidden = self.hidden_instances(&path, count);
-        let budget = memory_budget() / instance_bytes(&where_);
+        let budget = memory_left() / instance_bytes(&where_);
         let mut parts = Vec::with_capacity(prototypes.len());
         for prototype in &prototypes {
             // A prototype holding its own instancer would instance itself without end.

@@ -311,7 +311,10 @@ impl UsdLoader {
 
     /// The scene texture of the image at `asset`, decoded once per resolved file.
     pub(super) fn texture_file(&mut self, asset: &sdf::AssetPath, material: &str) -> Option<usize> {
-        let key = asset.resolved_path().unwrap_or(asset.as_str()).to_string();
+        // The file, not its spelling: `./t.png` and `sub/../t.png` decode once.
+        let resolved = asset.resolved_path().unwrap_or(asset.as_str());
+        let key = std::fs::canonicalize(resolved)
+            .map_or_else(|_| resolved.to_string(), |p| p.display().to_string());
         if let Some(&known) = self.textures.get(&key) {
             return known;
         }

@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 
 use openusd::ar::{self, Asset, ResolvedPath, Resolver};
 
-use crate::limits::memory_budget;
+use crate::limits::memory_left;
 use crate::load::access::{AccessError, AssetRoots, read_regular_file};
 
 /// Deepest nesting of `{`, `[` and `(` accepted in a `.usda` layer. openusd's text parser
@@ -128,7 +128,7 @@ impl Resolver for ConfinedResolver {
 /// (`pkg.usdz[dir/tex.png]`, packages nested in packages included), read whole but never
 /// beyond the memory budget. The caller has checked the outer file against the policy.
 pub fn read_asset(resolved: &str) -> io::Result<Vec<u8>> {
-    let budget = memory_budget();
+    let budget = memory_left();
     let Some((package, inner)) = ar::split_package_relative_path_outer(resolved) else {
         return read_regular_file(Path::new(resolved), resolved, budget)
             .map_err(|e| io::Error::other(e.to_string()));
@@ -164,15 +164,33 @@ fn read_member(
         Some((member, rest)) => (member, Some(rest)),
         None => (inner.to_string(), None),
     };
+    let mut archive = archive;
+    let declared = declared_members(&mut archive);
     let mut zip = zip::ZipArchive::new(archive).map_err(|e| {
         io::Error::new(
             io::ErrorKind::InvalidData,
             format!("not a zip archive: {e}"),
         )
     })?;
-    let entry = zip
-        .by_name(&member)
-        .map_err(|_| io::Error::new(io::ErrorKind::NotFound, format!("no member '{member}'")))?;
+    // The zip reader keeps one member per name; two members of one name leave it to the
+    // reader which one is the layer, so the package is refused rather than guessed at.
+    if let Some(declared) = declared.filter(|&n| n > zip.len() as u64) {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!(
+                "its directory lists {declared} members but only {} distinct names: members share a name, so which one is meant is ambiguous",
+                zip.len()
+            ),
+        ));
+    }
+    let entry = zip.by_name(&member).map_err(|e| match e {
+        zip::result::ZipError::FileNotFound => {
+            io::Error::new(io::ErrorKind::NotFound, format!("no member '{member}'"))
+        }
+        other => io::Error::other(format!(
+            "member '{member}' cannot be read ({other}; a usdz package stores its members uncompressed)"
+        )),
+    })?;
     if entry.size() > budget {
         return Err(io::Error::other(format!(
             "member '{member}' declares {} bytes, more than the memory budget",
@@ -189,6 +207,26 @@ fn read_member(
     match rest {
         Some(rest) => read_member(io::Cursor::new(bytes), &rest, budget, depth + 1),
         None => Ok(bytes),
+    }
+}
+
+/// The number of members the zip archive's end-of-central-directory record declares
+/// (APPNOTE 4.3.16), or `None` when there is no such record or it defers to the Zip64 one.
+fn declared_members(archive: &mut (impl io::Read + io::Seek)) -> Option<u64> {
+    use std::io::SeekFrom;
+    const SIGNATURE: [u8; 4] = *b"PK\x05\x06";
+    // The record (22 bytes) ends the file, followed by a comment of up to 65,535 bytes.
+    let end = archive.seek(SeekFrom::End(0)).ok()?;
+    let start = end.saturating_sub(22 + 0xffff);
+    archive.seek(SeekFrom::Start(start)).ok()?;
+    let mut tail = Vec::new();
+    archive.read_to_end(&mut tail).ok()?;
+    archive.seek(SeekFrom::Start(0)).ok()?;
+    let at = tail.windows(4).rposition(|w| w == SIGNATURE)?;
+    let total = tail.get(at + 10..at + 12)?;
+    match u16::from_le_bytes([total[0], total[1]]) {
+        0xffff => None,
+        n => Some(u64::from(n)),
     }
 }
 
