@@ -810,9 +810,27 @@ fn a_killed_checkpointed_render_resumes_into_the_uninterrupted_image() {
     std::thread::sleep(Duration::from_millis(300));
     // SAFETY: kills our own child, giving it no chance to write anything more.
     unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGKILL) };
+    let killed = child.id();
     let run = wait_limited(child, &out.path().join("stderr.txt"), started);
     assert_eq!(run.code, None, "killed");
     let done = samples_in(&checkpoint);
+    // What a kill during a checkpoint's write leaves: the next run in the folder removes it.
+    let host: String = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .unwrap()
+        .trim()
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '.' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let stranded = out
+        .path()
+        .join(format!(".gridtrace-{host}-{killed}-Ab12Cd.tmp"));
+    std::fs::write(&stranded, b"half a checkpoint").unwrap();
     assert!(done.start == 0 && done.end > 0, "{done:?}");
     let end = done.end + 7;
     let dir = scenes();
@@ -837,6 +855,10 @@ fn a_killed_checkpointed_render_resumes_into_the_uninterrupted_image() {
         &rest,
         "-q",
     ]);
+    assert!(
+        !stranded.exists(),
+        "the killed run's temporary file is still there"
+    );
     render(&[
         "merge",
         &path("partial.exr"),

@@ -56,7 +56,17 @@ pub fn output_lock() -> MutexGuard<'static, ()> {
 /// removes a probe file, which a signal must not strand).
 pub fn check_output(path: &Path) -> Result<(), OutputError> {
     let _writing = output_lock();
-    check_writable(path)
+    check_writable(path)?;
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty());
+    let (files, bytes) = crate::output::temporary::remove_stale(folder.unwrap_or(Path::new(".")));
+    if files > 0 {
+        crate::terminal::say(format_args!(
+            "note: removed {files} temporary file(s) ({}) left in {} by a run that was killed while writing",
+            crate::limits::Bytes(bytes),
+            folder.unwrap_or(Path::new(".")).display()
+        ));
+    }
+    Ok(())
 }
 
 /// Writes an output under the output lock, so no signal ends the process half-way through;

@@ -5,12 +5,15 @@
 //! `CreateImage` (type 4) with channels R, G, B, A, then `UpdateImageV3` (type 6) bands of
 //! rows with interleaved channels (offsets 0–3, stride 4).
 //!
-//! The viewer is a convenience: if it cannot be reached or goes away, the render goes on
-//! without it (one warning), and a stalled viewer delays a pass by at most the write
-//! timeout once.
+//! The viewer is a convenience and never holds up a render: a thread of its own connects
+//! and sends, the render hands it the latest image and goes on (a frame not yet sent is
+//! replaced by the newer one), each update must be sent within a deadline or the viewer is
+//! given up (one warning), and the final image waits for the viewer only briefly, after
+//! the output has been written.
 
 use std::io::{self, Write};
 use std::net::{TcpStream, ToSocketAddrs};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use crate::render::Image;
@@ -20,21 +23,18 @@ pub const CREATE_IMAGE: u8 = 4;
 /// tev's packet type of `UpdateImageV3` (channel offsets and strides).
 pub const UPDATE_IMAGE_V3: u8 = 6;
 
-/// Longest a connection attempt or a write may take before the viewer is given up.
-const TIMEOUT: Duration = Duration::from_secs(5);
+/// Longest a connection attempt, or the sending of one whole update, may take before the
+/// viewer is given up.
+const DEADLINE: Duration = Duration::from_secs(5);
+
+/// Bytes written between two looks at the deadline.
+const CHUNK: usize = 1 << 16;
 
 /// Least time between two updates of the view during a render.
 const MIN_INTERVAL: Duration = Duration::from_millis(250);
 
 /// Most pixel bytes in one update packet (tev buffers whole packets).
 const BAND_BYTES: usize = 1 << 22;
-
-/// A connection to a tev viewer, or none once it has gone away.
-pub struct LiveView {
-    stream: Option<TcpStream>,
-    name: String,
-    last: Option<Instant>,
-}
 
 /// A tev packet under construction.
 struct Packet(Vec<u8>);
@@ -99,14 +99,40 @@ pub fn create_image_packet(name: &str, width: u32, height: u32) -> Vec<u8> {
     packet.finish()
 }
 
-/// `UpdateImageV3` packets covering `image`, in bands of rows.
-pub fn update_image_packets(name: &str, image: &Image) -> Vec<Vec<u8>> {
-    let width = image.width as usize;
+/// The pixels a viewer is sent: RGBA, row by row.
+pub struct Frame {
+    /// Pixels per row.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Red, green, blue and alpha of each pixel, row by row from the top.
+    pub rgba: Vec<[f32; 4]>,
+}
+
+impl Frame {
+    /// The colour and alpha of `image`.
+    pub fn of(image: &Image) -> Frame {
+        Frame {
+            width: image.width,
+            height: image.height,
+            rgba: image
+                .pixels
+                .iter()
+                .zip(&image.alpha)
+                .map(|(p, &a)| [p.x, p.y, p.z, a])
+                .collect(),
+        }
+    }
+}
+
+/// `UpdateImageV3` packets covering `frame`, in bands of rows.
+pub fn update_image_packets(name: &str, frame: &Frame) -> Vec<Vec<u8>> {
+    let width = frame.width as usize;
     let rows_per_band = (BAND_BYTES / (16 * width.max(1))).max(1);
-    (0..image.height as usize)
+    (0..frame.height as usize)
         .step_by(rows_per_band)
         .map(|y0| {
-            let rows = rows_per_band.min(image.height as usize - y0);
+            let rows = rows_per_band.min(frame.height as usize - y0);
             let mut packet = Packet::new(UPDATE_IMAGE_V3)
                 .flag(false)
                 .text(name)
@@ -127,61 +153,188 @@ pub fn update_image_packets(name: &str, image: &Image) -> Vec<Vec<u8>> {
             }
             let range = y0 * width..(y0 + rows) * width;
             packet
-                .floats(range.flat_map(|i| {
-                    let p = image.pixels[i];
-                    [p.x, p.y, p.z, image.alpha[i]]
-                }))
+                .floats(frame.rgba[range].iter().flatten().copied())
                 .finish()
         })
         .collect()
 }
 
+/// What the render and the sending thread share.
+#[derive(Default)]
+struct Mailbox {
+    /// The newest frame not yet taken by the sender.
+    next: Option<Frame>,
+    /// No more frames will come.
+    closed: bool,
+    /// The sender has ended (viewer lost, never reached, or all sent).
+    ended: bool,
+    /// When the sender began the update it is sending, if it is sending one.
+    sending_since: Option<Instant>,
+}
+
+struct Shared {
+    mailbox: Mutex<Mailbox>,
+    changed: Condvar,
+}
+
+impl Shared {
+    fn lock(&self) -> MutexGuard<'_, Mailbox> {
+        self.mailbox.lock().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+/// A live view in tev, fed by a thread of its own.
+pub struct LiveView {
+    shared: Arc<Shared>,
+    last: Option<Instant>,
+}
+
 impl LiveView {
-    /// Connects to tev at `address` (HOST:PORT) and creates the image `gridtrace: NAME`.
-    pub fn connect(address: &str, name: &str, width: u32, height: u32) -> io::Result<LiveView> {
+    /// Starts a thread that connects to tev at `address` (HOST:PORT), creates the image
+    /// `gridtrace: NAME` and sends the frames it is given; if the viewer cannot be reached
+    /// or goes away, it warns once (naming `address`) and the render goes on without it.
+    pub fn start(address: &str, name: &str, width: u32, height: u32) -> LiveView {
+        let shared = Arc::new(Shared {
+            mailbox: Mutex::new(Mailbox::default()),
+            changed: Condvar::new(),
+        });
+        let (address, name) = (address.to_string(), format!("gridtrace: {name}"));
+        let for_sender = Arc::clone(&shared);
+        let started = std::thread::Builder::new()
+            .name("live view".into())
+            .spawn(move || {
+                let outcome = Sender::connect(&address, &name, width, height)
+                    .and_then(|mut sender| sender.run(&for_sender));
+                if let Err(e) = outcome {
+                    crate::terminal::say(format_args!(
+                        "warning: --display {address}: {e}; rendering without a live view"
+                    ));
+                }
+                for_sender.lock().ended = true;
+                for_sender.changed.notify_all();
+            });
+        if started.is_err() {
+            shared.lock().ended = true;
+        }
+        LiveView { shared, last: None }
+    }
+
+    /// True while the viewer is there and the last update is old enough for another.
+    pub fn wants_update(&self) -> bool {
+        !self.shared.lock().ended && self.last.is_none_or(|t| t.elapsed() >= MIN_INTERVAL)
+    }
+
+    /// Hands `image` to the sender, replacing a frame it has not taken yet.
+    pub fn show(&mut self, image: &Image) {
+        if self.shared.lock().ended {
+            return;
+        }
+        let frame = Frame::of(image);
+        self.shared.lock().next = Some(frame);
+        self.shared.changed.notify_all();
+        self.last = Some(Instant::now());
+    }
+
+    /// No more frames: waits at most `grace` for the sender to deliver the last one, and
+    /// not at all for a viewer still taking an earlier update after [`MIN_INTERVAL`] (it
+    /// would not see the last one in time anyway).
+    pub fn finish(&mut self, grace: Duration) {
+        let until = Instant::now() + grace;
+        let mut mailbox = self.shared.lock();
+        mailbox.closed = true;
+        self.shared.changed.notify_all();
+        if mailbox
+            .sending_since
+            .is_some_and(|t| t.elapsed() >= MIN_INTERVAL)
+        {
+            return;
+        }
+        while !mailbox.ended {
+            let left = until.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return;
+            }
+            mailbox = self
+                .shared
+                .changed
+                .wait_timeout(mailbox, left)
+                .unwrap_or_else(|p| p.into_inner())
+                .0;
+        }
+    }
+}
+
+/// The connection, owned by the sending thread.
+struct Sender {
+    stream: TcpStream,
+    name: String,
+}
+
+impl Sender {
+    fn connect(address: &str, name: &str, width: u32, height: u32) -> io::Result<Sender> {
         let target = address.to_socket_addrs()?.next().ok_or_else(|| {
             io::Error::new(io::ErrorKind::NotFound, "the address resolves to nothing")
         })?;
-        let mut stream = TcpStream::connect_timeout(&target, TIMEOUT)?;
-        stream.set_write_timeout(Some(TIMEOUT))?;
+        let stream = TcpStream::connect_timeout(&target, DEADLINE)?;
         stream.set_nodelay(true)?;
-        let name = format!("gridtrace: {name}");
-        stream.write_all(&create_image_packet(&name, width, height))?;
-        Ok(LiveView {
-            stream: Some(stream),
-            name,
-            last: None,
-        })
-    }
-
-    /// A view with no viewer.
-    pub fn disconnected() -> LiveView {
-        LiveView {
-            stream: None,
-            name: String::new(),
-            last: None,
-        }
-    }
-
-    /// True when connected and the last update is old enough for another.
-    pub fn wants_update(&self) -> bool {
-        self.stream.is_some() && self.last.is_none_or(|t| t.elapsed() >= MIN_INTERVAL)
-    }
-
-    /// Sends the image; on failure warns once and carries on without the viewer.
-    pub fn show(&mut self, image: &Image) {
-        let Some(stream) = &mut self.stream else {
-            return;
+        let mut sender = Sender {
+            stream,
+            name: name.to_string(),
         };
-        let sent = update_image_packets(&self.name, image)
-            .iter()
-            .try_for_each(|packet| stream.write_all(packet));
-        if let Err(e) = sent {
-            crate::terminal::say(format_args!(
-                "warning: the live view was lost ({e}); rendering goes on"
-            ));
-            self.stream = None;
+        sender.send(&[create_image_packet(name, width, height)])?;
+        Ok(sender)
+    }
+
+    /// Sends frames as they come until the view is closed and the last one is sent.
+    fn run(&mut self, shared: &Shared) -> io::Result<()> {
+        loop {
+            let frame = {
+                let mut mailbox = shared.lock();
+                mailbox.sending_since = None;
+                loop {
+                    if let Some(frame) = mailbox.next.take() {
+                        mailbox.sending_since = Some(Instant::now());
+                        break frame;
+                    }
+                    if mailbox.closed {
+                        return Ok(());
+                    }
+                    mailbox = shared
+                        .changed
+                        .wait(mailbox)
+                        .unwrap_or_else(|p| p.into_inner());
+                }
+            };
+            self.send(&update_image_packets(&self.name, &frame))
+                .map_err(|e| io::Error::new(e.kind(), format!("the live view was lost ({e})")))?;
         }
-        self.last = Some(Instant::now());
+    }
+
+    /// Writes `packets` within [`DEADLINE`] in all, however slowly the viewer reads.
+    fn send(&mut self, packets: &[Vec<u8>]) -> io::Result<()> {
+        let until = Instant::now() + DEADLINE;
+        for chunk in packets.iter().flat_map(|p| p.chunks(CHUNK)) {
+            let mut rest = chunk;
+            while !rest.is_empty() {
+                let left = until.saturating_duration_since(Instant::now());
+                if left.is_zero() {
+                    return Err(io::Error::new(
+                        io::ErrorKind::TimedOut,
+                        format!(
+                            "an update took longer than {} s to send",
+                            DEADLINE.as_secs()
+                        ),
+                    ));
+                }
+                self.stream.set_write_timeout(Some(left))?;
+                match self.stream.write(rest) {
+                    Ok(0) => return Err(io::ErrorKind::WriteZero.into()),
+                    Ok(n) => rest = &rest[n..],
+                    Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+                    Err(e) => return Err(e),
+                }
+            }
+        }
+        Ok(())
     }
 }

@@ -8,6 +8,7 @@ pub mod display;
 mod exr;
 pub mod merge;
 mod png;
+pub mod temporary;
 
 pub use exr::{
     ExrHeader, ExrPixels, read_header as read_exr_header, read_pixels as read_exr_pixels,
@@ -126,9 +127,7 @@ pub fn check_writable(path: &Path) -> Result<(), OutputError> {
         }
         Err(_) => {}
     }
-    tempfile::Builder::new()
-        .prefix(".gridtrace-")
-        .suffix(".tmp")
+    temporary::builder()
         .tempfile_in(parent_dir(path))
         .map(drop)
         .map_err(|e| fail(format!("cannot write here: {e}")))
@@ -146,8 +145,7 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".gridtrace-").suffix(".tmp");
+    let mut builder = temporary::builder();
     // Temporary files are private by default; an image should get the usual 0666 & !umask.
     #[cfg(unix)]
     {

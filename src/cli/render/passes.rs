@@ -114,18 +114,12 @@ pub fn render_passes(
         args.image.quiet || args.sampling.time_limit.is_some(),
     );
     let mut display = args.image.display.as_deref().map(|address| {
-        LiveView::connect(
+        LiveView::start(
             address,
             &recorder.scene_name,
             settings.width,
             settings.height,
         )
-        .unwrap_or_else(|e| {
-            crate::terminal::say(format_args!(
-                "warning: --display {address}: {e}; rendering without a live view"
-            ));
-            LiveView::disconnected()
-        })
     });
     let mut checkpoints = Checkpointer {
         every: args.image.checkpoint.map(Duration::from_secs_f64),

@@ -37,6 +37,13 @@ pub fn prepared(plan: &Plan, prepared: &Prepared, renderer: &Renderer, took: Dur
 }
 
 /// Says how the render ended, denoises if asked, writes the output and the summary.
+/// How long the final image may wait for a live viewer once the output is written: a
+/// twentieth of the render's time, between 10 ms and 2 s, so a slow viewer adds at most
+/// 5 % to a render.
+fn live_view_grace(render: Duration) -> Duration {
+    (render / 20).clamp(Duration::from_millis(10), Duration::from_secs(2))
+}
+
 pub fn finish(
     args: &Args,
     plan: &Plan,
@@ -68,6 +75,9 @@ pub fn finish(
     let record = recorder.record(&image, &stats);
     let view = args.image.view_transform.into();
     write_last(&plan.output, &image, &record, view)?;
+    if let Some(view) = &mut display {
+        view.finish(live_view_grace(stats.elapsed));
+    }
     if !args.image.quiet {
         let seconds = stats.elapsed.as_secs_f64().max(1e-9);
         let range = match args.sampling.samples {
