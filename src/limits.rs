@@ -14,7 +14,7 @@
 //! stacks, the allocator's own reservations), or what `--max-memory` says.
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 
 /// Set by `--max-memory`; 0 means "the machine's".
 static MAX_MEMORY: AtomicU64 = AtomicU64::new(0);
@@ -26,6 +26,38 @@ static IN_USE: AtomicUsize = AtomicUsize::new(0);
 /// all allocated: counted as held, so parallel work cannot take them too.
 static RESERVED: AtomicU64 = AtomicU64::new(0);
 
+/// Set in a child process that reads a file to see whether the reader survives it: there
+/// a failed allocation ends the process at once with an exit status that says why
+/// ([`EXIT_IMPOSSIBLE_ALLOCATION`] or [`EXIT_OUT_OF_MEMORY`]) instead of an abort.
+static EXIT_ON_ALLOCATION_FAILURE: AtomicBool = AtomicBool::new(false);
+
+/// Exit status of a probe child whose reader asked for more than the whole budget at once:
+/// a count read from a corrupt file.
+pub const EXIT_IMPOSSIBLE_ALLOCATION: i32 = 86;
+
+/// Exit status of a probe child that ran out of memory with requests each within budget.
+pub const EXIT_OUT_OF_MEMORY: i32 = 87;
+
+/// Makes a failed allocation end this process with a telling exit status; for a forked
+/// probe child only (it runs no destructors).
+pub fn exit_on_allocation_failure() {
+    EXIT_ON_ALLOCATION_FAILURE.store(true, Ordering::Relaxed);
+}
+
+/// Called with the size of a failed allocation: ends a probe child, else returns.
+fn allocation_failed(size: usize) {
+    if EXIT_ON_ALLOCATION_FAILURE.load(Ordering::Relaxed) {
+        let status = if size as u64 > memory_budget() {
+            EXIT_IMPOSSIBLE_ALLOCATION
+        } else {
+            EXIT_OUT_OF_MEMORY
+        };
+        // SAFETY: ends the process at once; nothing shared is left half done that matters
+        // to a child whose only output is its exit status.
+        unsafe { libc::_exit(status) };
+    }
+}
+
 /// The system allocator, counting what it hands out in [`IN_USE`].
 pub struct Accounting;
 
@@ -34,7 +66,9 @@ unsafe impl GlobalAlloc for Accounting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         // SAFETY: the caller's contract is System's.
         let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
+        if p.is_null() {
+            allocation_failed(layout.size());
+        } else {
             IN_USE.fetch_add(layout.size(), Ordering::Relaxed);
         }
         p
@@ -43,7 +77,9 @@ unsafe impl GlobalAlloc for Accounting {
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         // SAFETY: as above.
         let p = unsafe { System.alloc_zeroed(layout) };
-        if !p.is_null() {
+        if p.is_null() {
+            allocation_failed(layout.size());
+        } else {
             IN_USE.fetch_add(layout.size(), Ordering::Relaxed);
         }
         p
@@ -58,7 +94,9 @@ unsafe impl GlobalAlloc for Accounting {
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         // SAFETY: as above.
         let p = unsafe { System.realloc(ptr, layout, new_size) };
-        if !p.is_null() {
+        if p.is_null() {
+            allocation_failed(new_size);
+        } else {
             if new_size >= layout.size() {
                 IN_USE.fetch_add(new_size - layout.size(), Ordering::Relaxed);
             } else {

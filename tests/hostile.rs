@@ -92,6 +92,10 @@ const CASES: &[(&str, Expect)] = &[
         Expect::Error("the USD reader crashed"),
     ),
     (
+        "usd_expression_reference.usda",
+        Expect::Error("the USD reader crashed"),
+    ),
+    (
         "usd_deep_prims.usda",
         Expect::Error("nested 10000 levels deep"),
     ),
@@ -117,6 +121,10 @@ const CASES: &[(&str, Expect)] = &[
     (
         "usd_missing_sublayer.usda",
         Expect::Warning("unresolved sublayer @not_there.usda@"),
+    ),
+    (
+        "usd_many_missing_sublayers.usda",
+        Expect::Warning("99000 more layers are missing past the first 1000"),
     ),
     (
         "usd_broken_reference.usda",
@@ -449,6 +457,45 @@ fn every_hostile_scene_ends_in_a_clear_outcome_within_time_and_memory() {
         hungriest.1,
         hungriest.0 as f64 / 1e6
     );
+}
+
+/// Subdivision takes the deepest level that fits `--max-memory`, and a shutter read at 64
+/// instants keeps only what moves: neither passes the budget.
+#[test]
+fn subdivision_and_motion_steps_stay_within_the_budget() {
+    let _serial = serial();
+    let out = tempfile::tempdir().unwrap();
+    let image = out.path().join("out.exr");
+    let image = image.to_str().unwrap();
+    let common = [image, "--width", "16", "--spp", "1", "-q"];
+    let mut args = vec!["usd_subdivision_cage.usda", "--subdivision-level", "6"];
+    args.extend(["--max-memory", "1G", "-o"]);
+    args.extend(common);
+    let run = run_limited(&args, &scenes());
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("/Cage: subdivision to level 6 needs")
+            && run.stderr.contains("refined to level 5 instead"),
+        "{}",
+        run.stderr
+    );
+    assert!(run.peak < 1 << 30, "peak {} bytes", run.peak);
+    let peak_with_steps = |steps: &str| {
+        let mut args = vec![
+            "usd_moving_grid.usda",
+            "--frame",
+            "5",
+            "--shutter=-0.5..0.5",
+        ];
+        args.extend(["--motion-steps", steps, "-o"]);
+        args.extend(common);
+        let run = run_limited(&args, &scenes());
+        assert_eq!(run.code, Some(0), "{}", run.stderr);
+        run.peak
+    };
+    let (two, many) = (peak_with_steps("2"), peak_with_steps("64"));
+    println!("moving grid: peak {two} bytes at 2 motion steps, {many} at 64");
+    assert!(many < 2 * two, "64 steps take {many} bytes, 2 steps {two}");
 }
 
 /// One image file named by four spellings of its URI is decoded once.

@@ -54,6 +54,12 @@ pub struct LoadOptions {
     /// Levels of Catmull–Clark refinement for USD meshes that ask for subdivision
     /// (`None`: [`DEFAULT_SUBDIVISION_LEVEL`]).
     pub subdivision_level: Option<u32>,
+    /// More frames the USD crash probe reads the stage at, besides `frame`: a shutter's
+    /// instants, so that one child process probes them all.
+    pub probe_also_at: Vec<f64>,
+    /// The stage has been probed at this frame already (by a probe given it in
+    /// `probe_also_at`): read it without a child process.
+    pub probed: bool,
 }
 
 /// Levels a subdivision surface is refined to by default: Blender's Subdivision modifier

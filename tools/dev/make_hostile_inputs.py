@@ -215,6 +215,10 @@ def Mesh "Floor"
         write(j("corrupt.usdc"), f.read())
     write(j("usd_corrupt_reference.usda"), usda("def Xform \"Ref\" (\n    prepend references = @corrupt.usdc@\n)\n{\n}\n"))
     write(j("usd_corrupt_sublayer.usda"), usda(metadata="    subLayers = [@corrupt.usdc@]\n"))
+    # The same layer named by a variable expression, which only composition resolves.
+    write(j("usd_expression_reference.usda"), usda(
+        "def Xform \"Ref\" (\n    prepend references = @`\"./${V}.usdc\"`@\n)\n{\n}\n",
+        metadata="    expressionVariables = {\n        string V = \"corrupt\"\n    }\n"))
     # Deep, but not past the parser's limit: the prim walk's own limit answers.
     write(j("usd_deep_hierarchy.usda"), usda("".join(f"def Xform \"P{i}\" {{\n" for i in range(300)) + "}\n" * 300))
     depth = 10000
@@ -251,6 +255,8 @@ def Mesh "Floor"
 
     # 5. Content silently dropped, impossible cameras and materials, overflowing counts.
     write(j("usd_missing_sublayer.usda"), usda(metadata="    subLayers = [@not_there.usda@]\n"))
+    many = ", ".join(f"@missing_{i}.usda@" for i in range(100_000))
+    write(j("usd_many_missing_sublayers.usda"), usda(metadata=f"    subLayers = [{many}]\n"))
     write(j("broken.usda"), "#usda 1.0\ndef Xform \"X\" {{{ oops\n")
     write(j("usd_broken_reference.usda"), usda("def Xform \"Ref\" (\n    prepend references = @broken.usda@\n)\n{\n}\n"))
     write(j("usd_negative_counts.usda"), usda("""def Mesh "Bad"
@@ -397,6 +403,23 @@ def flat_hdr(width, height):
     return header + bytes([128, 128, 128, 129]) * (width * height)
 
 
+def grid_mesh(name, n, spacing=1.0, extra=""):
+    """A Mesh prim of n×n quads in the XY plane."""
+    points = ", ".join(f"({x * spacing:g}, {y * spacing:g}, 0)" for y in range(n + 1) for x in range(n + 1))
+    corners = []
+    for y in range(n):
+        for x in range(n):
+            a = y * (n + 1) + x
+            corners += [a, a + 1, a + n + 2, a + n + 1]
+    return f"""def Mesh "{name}"
+{{
+{extra}    int[] faceVertexCounts = [{", ".join(["4"] * (n * n))}]
+    int[] faceVertexIndices = [{", ".join(map(str, corners))}]
+    point3f[] points = [{points}]
+}}
+"""
+
+
 def textured_gltf(uri):
     """The quad with a base colour texture read from `uri`."""
     doc = gltf()
@@ -446,6 +469,17 @@ def make_memory_text_and_silent_cases(j):
 }
 """
     write(j("usd_dome_bomb.usda"), usda(dome))
+    # Subdivision and motion steps under --max-memory: a 1,024-quad cage, and a 25,600-quad
+    # mesh that moves (tests/hostile.rs gives the levels, steps and budget).
+    write(j("usd_subdivision_cage.usda"), usda(grid_mesh(
+        "Cage", 32, extra='    uniform token subdivisionScheme = "catmullClark"\n')))
+    moving = grid_mesh("Grid", 160, spacing=0.01)
+    write(j("usd_moving_grid.usda"), usda(f"""def Xform "Mover"
+{{
+    double3 xformOp:translate.timeSamples = {{1: (0, 0, 0), 10: (1, 0, 0)}}
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+{moving}}}
+""", metadata="    startTimeCode = 1\n    endTimeCode = 10\n"))
     # Control characters in names and URIs from the file.
     doc = gltf()
     doc["meshes"][0]["name"] = "quad\x1b[2J\nerror: forged second line"

@@ -61,6 +61,7 @@ pub fn read_request(args: &Args) -> Result<Request<'_>> {
         animation: loading.animation.clone(),
         asset_paths: loading.asset_path.clone(),
         subdivision_level: loading.subdivision_level,
+        ..LoadOptions::default()
     };
     for dir in &loading.asset_path {
         if !dir.is_dir() {

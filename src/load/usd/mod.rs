@@ -26,7 +26,7 @@ mod resolver;
 mod skel;
 mod value;
 
-use resolver::{ConfinedResolver, Refusals};
+use resolver::{ConfinedResolver, MAX_MISSING_LAYERS, Refusals, Skipped};
 use value::{as_f64, as_token, value};
 
 use super::{AssetRoots, LoadError, LoadOptions, Loaded};
@@ -38,6 +38,9 @@ const MAX_DEPTH: usize = 256;
 
 /// Segments of the polygon a `DiskLight` becomes.
 const DISK_SEGMENTS: u32 = 48;
+
+/// Composition errors warned about one by one; the rest are counted in one warning.
+const SHOWN_COMPOSITION_ERRORS: usize = 10;
 
 /// Loads a USD stage at its `startTimeCode` with default options; see [`load_with`].
 pub fn load(path: &Path) -> Result<Loaded, LoadError> {
@@ -67,9 +70,12 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError
     let roots = AssetRoots::for_scene(path, &options.asset_paths);
     let time = options.frame;
     crate::load::guard::catching_panics(|| {
-        if probe::may_hold_binary_layers(path) {
+        if !options.probed && probe::may_hold_binary_layers(path) {
+            let times = std::iter::once(time).chain(options.probe_also_at.iter().map(|&t| Some(t)));
             probe::probe_stage(path, || {
-                read_stage(path, time, options.subdivision_levels(), &roots).is_ok()
+                times
+                    .into_iter()
+                    .all(|t| read_stage(path, t, options.subdivision_levels(), &roots).is_ok())
             })?;
         }
         read_stage(path, time, options.subdivision_levels(), &roots)
@@ -102,12 +108,17 @@ fn read_stage(
         });
     }
     let refused = Refusals::default();
+    let skipped = Skipped::default();
     let refusal = |refused: &Refusals| {
         let first = refused.lock().ok()?.first().cloned()?;
         Some(invalid(first))
     };
     let stage = usd::Stage::builder()
-        .resolver(ConfinedResolver::new(roots.clone(), refused.clone()))
+        .resolver(ConfinedResolver::new(
+            roots.clone(),
+            refused.clone(),
+            skipped.clone(),
+        ))
         .open(name)
         .map_err(|e| {
             refusal(&refused).unwrap_or_else(|| invalid(format!("cannot open USD stage: {e:#}")))
@@ -155,9 +166,25 @@ fn read_stage(
     if let Some(error) = refusal(&refused) {
         return Err(error);
     }
-    // Layers that could not be found or read drop their content: say so.
-    for error in loader.stage.composition_errors() {
+    // Layers that could not be found or read drop their content: say so, the first few
+    // one by one and the rest in one line.
+    let errors = loader.stage.composition_errors();
+    for error in errors.iter().take(SHOWN_COMPOSITION_ERRORS) {
         loader.warn(format!("{error}; its content is left out"));
+    }
+    if errors.len() > SHOWN_COMPOSITION_ERRORS {
+        loader.warn(format!(
+            "{} more composition errors like these; their content is left out",
+            errors.len() - SHOWN_COMPOSITION_ERRORS
+        ));
+    }
+    if let Ok(skipped) = skipped.lock()
+        && let Some(first) = &skipped.first
+    {
+        loader.warn(format!(
+            "{} more layers are missing past the first {MAX_MISSING_LAYERS} (the first of them @{first}@); they were not looked for and their content is left out",
+            skipped.names.len()
+        ));
     }
     // Layer identifiers are absolute; the stage's own file is not a dependency.
     let own = path.canonicalize().ok();

@@ -8,10 +8,14 @@
 use std::path::Path;
 
 use super::resolver::is_layer;
+use crate::limits::{Bytes, EXIT_IMPOSSIBLE_ALLOCATION, EXIT_OUT_OF_MEMORY, memory_budget};
 use crate::load::LoadError;
 
-/// False only for a text layer that names no other layer (no `@….usd[acz]@` asset path):
-/// such a stage holds nothing the binary reader sees, and need not be read twice.
+/// False only for a text layer whose asset paths all name images: such a stage holds
+/// nothing the binary reader sees, and need not be read twice. Any other asset path may
+/// lead to a binary layer — by name (`@x.usdc@`), through a variable expression
+/// (`` @`"./${V}.usdc"`@ ``, resolved only during composition) or a file without a layer
+/// extension — so the stage is probed.
 pub fn may_hold_binary_layers(path: &Path) -> bool {
     let text = path
         .extension()
@@ -24,11 +28,31 @@ pub fn may_hold_binary_layers(path: &Path) -> bool {
     };
     // Asset paths lie between `@` signs; looking at every piece between two of them (not
     // only the odd ones) stays safe when a string or comment holds a stray `@`.
+    // A stray `@` shifts which pieces are asset paths: every piece is checked for layers
+    // and expressions, and the pieces in asset-path places must be images.
     let pieces: Vec<&[u8]> = bytes.split(|&b| b == b'@').collect();
-    pieces.len() > 2
-        && pieces[1..pieces.len() - 1]
-            .iter()
-            .any(|piece| is_layer(&String::from_utf8_lossy(piece)))
+    if pieces.len() <= 2 {
+        return false;
+    }
+    let inner = &pieces[1..pieces.len() - 1];
+    inner.iter().any(|piece| {
+        let piece = String::from_utf8_lossy(piece);
+        is_layer(&piece) || piece.starts_with('`')
+    }) || inner
+        .iter()
+        .step_by(2)
+        .any(|piece| !is_image(&String::from_utf8_lossy(piece)))
+}
+
+/// True for a path with the extension of an image format a texture may have.
+fn is_image(path: &str) -> bool {
+    let path = path.to_ascii_lowercase();
+    [
+        ".png", ".jpg", ".jpeg", ".exr", ".hdr", ".webp", ".tga", ".tif", ".tiff", ".bmp", ".ktx2",
+        ".tx",
+    ]
+    .iter()
+    .any(|e| path.ends_with(e))
 }
 
 /// Runs `load` in a forked child; a child killed by a signal (an abort, a stack overflow,
@@ -66,6 +90,7 @@ pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadE
                 libc::signal(signal, libc::SIG_DFL);
             }
         }
+        crate::limits::exit_on_allocation_failure();
         let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(load));
         // SAFETY: ends the child at once, as fork's documentation asks.
         unsafe { libc::_exit(0) };
@@ -86,23 +111,35 @@ pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadE
             break waited;
         }
     };
-    // The child leaves with status 0 whatever the load gave; anything else is a crash.
-    let how = if libc::WIFSIGNALED(status) {
-        Some(format!("signal {}", libc::WTERMSIG(status)))
-    } else if libc::WIFEXITED(status) && libc::WEXITSTATUS(status) != 0 {
-        Some(format!("exit status {}", libc::WEXITSTATUS(status)))
-    } else {
-        None
-    };
-    match how {
-        Some(how) if waited == pid => Err(LoadError::Invalid {
-            path: path.to_path_buf(),
-            what: format!(
-                "the USD reader crashed on this stage or a layer it uses ({how}); a layer is probably corrupt"
-            ),
-        }),
-        _ => Ok(()),
+    if waited != pid {
+        return Ok(());
     }
+    // The child leaves with status 0 whatever the load gave; anything else is a crash.
+    let crashed = |how: String| {
+        format!(
+            "the USD reader crashed on this stage or a layer it uses ({how}); a layer is probably corrupt"
+        )
+    };
+    let what = if libc::WIFSIGNALED(status) {
+        crashed(format!("signal {}", libc::WTERMSIG(status)))
+    } else if !libc::WIFEXITED(status) || libc::WEXITSTATUS(status) == 0 {
+        return Ok(());
+    } else {
+        match libc::WEXITSTATUS(status) {
+            EXIT_IMPOSSIBLE_ALLOCATION => {
+                crashed("it asked for more memory at once than this run may use".into())
+            }
+            EXIT_OUT_OF_MEMORY => format!(
+                "reading the stage ran out of memory: it needs more than the {} this run may use (--max-memory, ulimit -v)",
+                Bytes(memory_budget())
+            ),
+            code => crashed(format!("exit status {code}")),
+        }
+    };
+    Err(LoadError::Invalid {
+        path: path.to_path_buf(),
+        what,
+    })
 }
 
 #[cfg(not(unix))]
