@@ -161,7 +161,7 @@ impl Instant {
                 .into_iter()
                 .zip(&base.meshes)
                 .map(|(at, frame)| {
-                    (at.positions != frame.positions).then(|| Shape {
+                    (at.positions != frame.positions).then_some(Shape {
                         positions: at.positions,
                         normals: at.normals,
                         tangents: at.tangents,
