@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use super::choices::{FilterChoice, LightUnitsChoice, ViewChoice};
+use super::choices::{FilterChoice, LightUnitsChoice, ProgressChoice, ViewChoice};
 use super::values::{
     EnvironmentChoice, parse_degrees, parse_distance, parse_environment, parse_exposure,
     parse_filter_width, parse_fps, parse_frame, parse_fstop, parse_motion_steps, parse_seconds,
@@ -120,6 +120,12 @@ pub struct OutputArgs {
     /// default is 127.0.0.1:14158). A viewer that goes away does not stop the render.
     #[arg(long, value_name = "HOST:PORT")]
     pub display: Option<String>,
+
+    /// Report progress for a program to read: `json` prints a line after each pass but the
+    /// last on stderr,
+    /// `{"pass":K,"of":N,"seconds":T}` (N: the most passes the render may take).
+    #[arg(long, value_name = "FORMAT")]
+    pub progress: Option<ProgressChoice>,
 
     /// No progress bar and no summary; warnings and errors are still printed.
     #[arg(short, long)]

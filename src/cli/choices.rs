@@ -31,6 +31,13 @@ impl From<LightUnitsChoice> for GltfLightUnits {
 }
 
 /// Which pixel filter.
+/// `--progress`: how progress is reported for programs (the Blender add-on).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ProgressChoice {
+    /// One JSON object per pass on stderr: `{"pass":K,"of":N,"seconds":T}`.
+    Json,
+}
+
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum FilterChoice {
     /// Uniform over a square `width` pixels wide (1: the pixel itself).

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Everything the tests and benchmarks need beyond the Rust toolchain: Embree 4 (with
 # libclang for its bindings), Open Image Denoise 2, the Stanford dragon, the npm glTF tools
-# (tools/dev/npm), and Slurm with munge for the cluster test. Idempotent; safe to run every
+# (tools/dev/npm), Slurm with munge for the cluster test, and Blender as a Python module
+# for the add-on's test. Idempotent; safe to run every
 # time.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -10,3 +11,4 @@ tools/user/install-oidn.sh
 tools/dev/fetch-dragon.sh
 tools/dev/install-npm-tools.sh
 tools/dev/install-slurm.sh
+tools/dev/install-blender.sh

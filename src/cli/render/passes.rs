@@ -128,7 +128,18 @@ pub fn render_passes(
         output: &plan.output,
         view: args.image.view_transform.into(),
     };
+    let most_passes = settings.spp();
+    let mut passes_done = 0u32;
+    let report_progress = args.image.progress.is_some();
+    let started = Instant::now();
     let mut on_pass = |image_so_far: &dyn Fn() -> (Image, RenderStats)| {
+        passes_done += 1;
+        if report_progress {
+            crate::terminal::say(format_args!(
+                "{{\"pass\":{passes_done},\"of\":{most_passes},\"seconds\":{:.3}}}",
+                started.elapsed().as_secs_f64()
+            ));
+        }
         if let Some(view) = &mut display
             && view.wants_update()
         {
