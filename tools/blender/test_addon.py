@@ -17,6 +17,13 @@ throw-away Blender user folder, builds the bundled Cornell box in bpy, and check
   field, motion blur, world colour, view transform, film transparency;
 - "Write Slurm Job" writes the scene, the Slurm scripts and a submit.sh.
 Prints one line per check; exits non-zero on the first failure.
+
+    python3 tools/blender/test_addon.py path/to/gridtrace --references OUT SPP
+
+renders the project's Blender reference scenes through the add-on instead, as Cycles'
+references were made (tools/blender/make_references.py: two halves, seeds 1 and 2, box
+filter, no world), into OUT/NAME_a.exr and OUT/NAME_b.exr, for tests/blender_addon.rs to
+compare with tests/data/references/.
 """
 
 import glob
@@ -258,8 +265,49 @@ def test_farm():
     print("ok: Write Slurm Job writes the scene, the Slurm scripts and submit.sh")
 
 
+# The reference scenes rendered through the add-on: the Cornell box, Principled metals and
+# plastics (tools/blender/make_principled.py) and Blender's lamps (make_lighting.py).
+REFERENCE_SCENES = ("cornell_box", "principled_metals", "principled_plastics", "lighting_lamps")
+
+
+def render_references(out, spp):
+    import make_lighting
+    import make_principled
+    import make_references
+
+    builders = {name: entry[0] for name, entry in make_references.SCENE_TABLE.items()}
+    builders.update({name: entry[0] for name, entry in make_principled.SCENE_TABLE.items()})
+    builders.update({name: entry[0] for name, entry in make_lighting.SCENE_TABLE.items()})
+    for name in REFERENCE_SCENES:
+        scene = make_cornell.reset()
+        enable()
+        builders[name](scene)
+        scene.world = None
+        scene.render.engine = "GRIDTRACE"
+        scene.render.resolution_x = scene.render.resolution_y = make_references.SIZE
+        scene.render.resolution_percentage = 100
+        scene.render.film_transparent = False
+        scene.render.image_settings.file_format = "OPEN_EXR"
+        scene.render.image_settings.color_depth = "32"
+        scene.render.image_settings.color_mode = "RGB"
+        scene.gridtrace.samples = spp // 2
+        scene.gridtrace.pixel_filter = "BOX"
+        scene.gridtrace.filter_width = 1.0
+        for half, seed in (("a", 1), ("b", 2)):
+            scene.gridtrace.seed = seed
+            scene.render.filepath = os.path.join(out, f"{name}_{half}.exr")
+            bpy.ops.render.render(write_still=True)
+            check(os.path.isfile(scene.render.filepath), f"{name}: no image")
+        print(f"ok: rendered {name} through the add-on at {spp} spp")
+
+
 def main():
     install()
+    if "--references" in sys.argv:
+        at = sys.argv.index("--references")
+        render_references(os.path.abspath(sys.argv[at + 1]), int(sys.argv[at + 2]))
+        shutil.rmtree(WORK)
+        return
     test_f12_and_passes()
     test_animation()
     test_cancel()
