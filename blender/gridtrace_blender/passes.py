@@ -11,6 +11,16 @@ PASSES = {
 
 COMBINED = ["R", "G", "B", "A"]
 
+# Passes holding directions or points: gridtrace works Y-up (the exported stage's Z-up
+# turned as USD's upAxis says), Blender's world is Z-up; Blender (x, y, z) is gridtrace
+# (x, z, -y), so gridtrace's (x, y, z) is Blender's (x, -z, y).
+IN_WORLD_SPACE = {"normal", "position"}
+
+
+def to_blender_axes(x, y, z):
+    """A direction or point of gridtrace's world in Blender's."""
+    return x, -z, y
+
 
 def wanted(scene, view_layer):
     """The keys of PASSES this view layer asks for: Blender's own toggles (Z, Normal,

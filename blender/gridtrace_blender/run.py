@@ -182,20 +182,23 @@ def fill(result, planes, keys, width, height, combined_only=False):
     bottom to top)."""
     layer = result.layers[0]
 
-    def put(name, channels):
+    def put(name, channels, world_space=False):
         target = layer.passes.find_by_name(name, layer.name) if hasattr(layer.passes, "find_by_name") else None
         if target is None:
             target = layer.passes.get(name)
         if target is None or any(c not in planes for c in channels):
             return
-        data = np.stack([planes[c][::-1, :] for c in channels], axis=-1).reshape(-1, len(channels))
+        values = [planes[c][::-1, :] for c in channels]
+        if world_space:
+            values = list(passes.to_blender_axes(*values))
+        data = np.stack(values, axis=-1).reshape(-1, len(channels))
         target.rect.foreach_set(np.ascontiguousarray(data, dtype=np.float32).ravel())
 
     put("Combined", passes.COMBINED)
     if not combined_only:
         for key in keys:
             name, _, _, _, _, channels = passes.PASSES[key]
-            put(name, channels)
+            put(name, channels, key in passes.IN_WORLD_SPACE)
 
 
 def render(engine, depsgraph):

@@ -138,13 +138,18 @@ def test_f12_and_passes():
     image, last = f12(scene, "f12.exr", keep)
     check(image is not None, f"F12 wrote no image: {last}")
     expected = cli(last["command"], keep)
+    # Normals in Blender's Z-up world: gridtrace's (x, y, z) is Blender's (x, -z, y).
+    expected["normal.-Z"] = -expected["normal.Z"]
     pairs = {"ViewLayer.Combined." + c: c for c in "RGBA"}
     pairs.update({"ViewLayer.Depth.Z": "depth.Z"})
-    pairs.update({f"ViewLayer.Normal.{c}": f"normal.{c}" for c in "XYZ"})
+    pairs.update({"ViewLayer.Normal.X": "normal.X", "ViewLayer.Normal.Y": "normal.-Z", "ViewLayer.Normal.Z": "normal.Y"})
     pairs.update({f"ViewLayer.Denoising Albedo.{c}": f"albedo.{c}" for c in "RGB"})
     for blender, ours in pairs.items():
         check(blender in image and ours in expected, f"missing {blender} or {ours}: {sorted(image)}")
         check(np.array_equal(image[blender], expected[ours]), f"{blender} differs from the CLI's {ours}")
+    # The floor faces +Z and the ceiling -Z in Blender's world.
+    up = image["ViewLayer.Normal.Z"]
+    check(up.max() > 0.999 and up.min() < -0.999, f"normals along Z span {up.min()}..{up.max()}")
     check(image["ViewLayer.Combined.R"].mean() > 0.05, "the F12 image is dark")
     print(f"ok: F12 at 64x64 equals the CLI render bit for bit, passes included ({len(pairs)} channels)")
 
