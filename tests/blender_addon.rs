@@ -80,6 +80,8 @@ fn the_add_on_agrees_with_cycles_on_the_reference_scenes() {
         "principled_metals",
         "principled_plastics",
         "lighting_lamps",
+        "lighting_hdr",
+        "lighting_dof",
     ] {
         let half = |h: &str| read_exr(&out.path().join(format!("{name}_{h}.exr")));
         let ours = Halves {

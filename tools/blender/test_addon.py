@@ -271,8 +271,10 @@ def test_farm():
 
 
 # The reference scenes rendered through the add-on: the Cornell box, Principled metals and
-# plastics (tools/blender/make_principled.py) and Blender's lamps (make_lighting.py).
-REFERENCE_SCENES = ("cornell_box", "principled_metals", "principled_plastics", "lighting_lamps")
+# plastics (tools/blender/make_principled.py), and from make_lighting.py Blender's lamps, an
+# HDR world and a camera's depth of field (whose references keep the world).
+REFERENCE_SCENES = ("cornell_box", "principled_metals", "principled_plastics", "lighting_lamps", "lighting_hdr",
+                    "lighting_dof")
 
 
 def render_references(out, spp):
@@ -287,7 +289,8 @@ def render_references(out, spp):
         scene = make_cornell.reset()
         enable()
         builders[name](scene)
-        scene.world = None
+        if not name.startswith("lighting_"):
+            scene.world = None
         scene.render.engine = "GRIDTRACE"
         scene.render.resolution_x = scene.render.resolution_y = make_references.SIZE
         scene.render.resolution_percentage = 100
