@@ -62,16 +62,51 @@ pub struct Scene {
     pub environment: Option<Environment>,
 }
 
+/// Farthest from the origin geometry may lie and still be traced: squared distances and
+/// the products of ray–triangle tests overflow 32-bit floats (3.4·10³⁸) beyond about
+/// 1.8·10¹⁹, and leave room for the scene's extent on top.
+pub const MAX_COORDINATE: f32 = 1e18;
+
 impl Scene {
     /// World-space bounds of every instance (over the whole shutter for moving ones).
     pub fn bounds(&self) -> Aabb {
-        self.instances.iter().fold(Aabb::EMPTY, |b, inst| {
-            let object = self.meshes[inst.mesh].bounds();
-            b.union(match &inst.motion {
-                None => object.transformed(&inst.world_from_object),
-                Some(motion) => motion.bounds(&object),
-            })
-        })
+        self.instances
+            .iter()
+            .fold(Aabb::EMPTY, |b, inst| b.union(self.instance_bounds(inst)))
+    }
+
+    /// World-space bounds of one instance.
+    fn instance_bounds(&self, inst: &Instance) -> Aabb {
+        let object = self.meshes[inst.mesh].bounds();
+        match &inst.motion {
+            None => object.transformed(&inst.world_from_object),
+            Some(motion) => motion.bounds(&object),
+        }
+    }
+
+    /// Leaves out the instances that reach beyond [`MAX_COORDINATE`] (or are not finite),
+    /// which would otherwise come out as nothing without a word; returns their sources.
+    pub fn drop_untraceable_instances(&mut self) -> Vec<String> {
+        let traceable = |b: &Aabb| {
+            b.is_empty()
+                || (b.min.abs().max_element() <= MAX_COORDINATE
+                    && b.max.abs().max_element() <= MAX_COORDINATE)
+        };
+        let keep: Vec<bool> = self
+            .instances
+            .iter()
+            .map(|i| traceable(&self.instance_bounds(i)))
+            .collect();
+        let mut dropped = Vec::new();
+        let mut flags = keep.iter();
+        self.instances.retain(|i| {
+            let kept = *flags.next().unwrap_or(&true);
+            if !kept {
+                dropped.push(i.source.clone());
+            }
+            kept
+        });
+        dropped
     }
 
     /// True when some instanced mesh has an emissive material or there is a punctual light.

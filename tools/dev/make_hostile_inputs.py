@@ -420,6 +420,15 @@ def grid_mesh(name, n, spacing=1.0, extra=""):
 """
 
 
+def webp_header(width, height):
+    """The first bytes of a lossless WebP of `width`×`height` (RIFF, a VP8L chunk, its
+    14-bit sizes; WebP Lossless Bitstream §3): what a decoder sizes its output from."""
+    bits = (width - 1) | ((height - 1) << 14) | (1 << 28)  # alpha used, version 0
+    payload = b"\x2f" + struct.pack("<I", bits) + bytes(8)
+    chunk = b"VP8L" + struct.pack("<I", len(payload)) + payload
+    return b"RIFF" + struct.pack("<I", 4 + len(chunk)) + b"WEBP" + chunk
+
+
 def textured_gltf(uri):
     """The quad with a base colour texture read from `uri`."""
     doc = gltf()
@@ -449,6 +458,8 @@ def make_memory_text_and_silent_cases(j):
     with zipfile.ZipFile(j("usdz_png_bomb.usdz"), "w") as z:
         z.writestr("root.usda", usda(textured_material("Bomb", "bomb.png")).replace("</Glow>", "</Bomb>", 1))
         z.write(j("bomb.png"), "bomb.png")
+    write(j("bomb.webp"), webp_header(16383, 16383))
+    write_json(j("webp_bomb.gltf"), textured_gltf("bomb.webp"))
     # One image spelt four ways decodes once (tests/hostile.rs counts the textures).
     os.makedirs(j("sub"), exist_ok=True)
     write(j("t.png"), grey_png(4, 4))
@@ -486,6 +497,14 @@ def make_memory_text_and_silent_cases(j):
     doc["accessors"][1]["count"] = 7  # reads past its view: an error naming the mesh
     write_json(j("escape_in_name.gltf"), doc)
     write_json(j("escape_in_uri.gltf"), textured_gltf("\x1b]0;owned\x07missing.png"))
+    # A hard link inside the folder to a file outside it: read (it is the file itself), but
+    # no message may show its bytes.
+    os.link(os.path.join(os.path.dirname(j("x")), "..", "secret.txt"), j("hardlink.bin"))
+    write_json(j("leak_hardlink.gltf"), leaking_gltf("hardlink.bin"))
+    # Geometry scaled past what 32-bit floats can trace.
+    doc = gltf()
+    doc["nodes"] = [{"mesh": 0, "scale": [1e38, 1e38, 1e38]}]
+    write_json(j("huge_scale.gltf"), doc)
     # Clipping that would hide everything.
     write_json(j("camera_near_beyond_far.gltf"), with_camera(
         {"type": "perspective", "perspective": {"yfov": 0.8, "znear": 10, "zfar": 1}}))

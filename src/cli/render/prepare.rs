@@ -89,6 +89,13 @@ pub fn prepare(args: &Args, plan: &Plan) -> Result<Prepared> {
         crate::terminal::say(format_args!("warning: {warning}"));
     }
     let mut scene = loaded.scene;
+    for source in scene.drop_untraceable_instances() {
+        crate::terminal::say(format_args!(
+            "warning: {}: {source} reaches beyond {:e} from the origin, farther than 32-bit floats can trace; left out",
+            scene_path.display(),
+            crate::scene::MAX_COORDINATE
+        ));
+    }
     let environment = apply_environment(&mut scene, &args.world)?;
     check_contents(args, plan, &scene, &environment)?;
     let camera = pick?.camera(&scene, args.view.width, args.view.height)?;
