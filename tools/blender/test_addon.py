@@ -36,6 +36,9 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 WORK = tempfile.mkdtemp(prefix="gridtrace-addon-test-")
+# The add-on's temporary folders go here, apart from any other run's.
+tempfile.tempdir = os.path.join(WORK, "tmp")
+os.makedirs(tempfile.tempdir)
 # A Blender user folder of our own: installing the add-on touches nothing of the user's.
 os.environ["BLENDER_USER_RESOURCES"] = os.path.join(WORK, "blender-user")
 os.environ["BLENDER_USER_SCRIPTS"] = os.path.join(WORK, "blender-user", "scripts")
@@ -188,6 +191,7 @@ def test_cancel():
     scene = cornell(samples=100000)
     run = sys.modules[MODULE + ".run"]
     before = set(glob.glob(os.path.join(tempfile.gettempdir(), "gridtrace-blender-*")))
+    check(not before, f"temporary folders before: {before}")
     # Esc, as soon as gridtrace has reported its first pass.
     run.should_stop = lambda engine: bool(run.LAST.get("passes"))
     try:
@@ -198,8 +202,9 @@ def test_cancel():
     record = dict(line.split("=", 1) for line in last["record"].splitlines())
     start, end = (int(v) for v in record["samples"].split(".."))
     check(start == 0 and 1 <= end < 100000, f"samples {record['samples']}")
-    running = subprocess.run(["pgrep", "-f", "gridtrace-blender-"], capture_output=True, text=True).stdout
-    check(not running.strip(), f"a gridtrace process is left: {running}")
+    # No child of this process (Blender) is left: gridtrace was waited for.
+    running = subprocess.run(["pgrep", "-P", str(os.getpid())], capture_output=True, text=True).stdout.split()
+    check(not running, f"a child process is left: {running}")
     after = set(glob.glob(os.path.join(tempfile.gettempdir(), "gridtrace-blender-*")))
     check(after == before, f"temporary folders left: {after - before}")
     print(f"ok: a render stopped after its first pass returns samples {record['samples']}, "
