@@ -18,13 +18,15 @@ class GridtracePanel:
 
 class GRIDTRACE_PT_render(GridtracePanel, bpy.types.Panel):
     bl_label = "gridtrace"
+    # The settings it shows, in order.
+    SHOWN = ("samples", "max_depth", "noise_threshold", "time_limit", "denoise", "pixel_filter", "filter_width",
+             "seed", "threads", "update_seconds")
 
     def draw(self, context):
         settings = context.scene.gridtrace
         layout = self.layout
         layout.use_property_split = True
-        for name in ("samples", "max_depth", "noise_threshold", "time_limit", "denoise", "pixel_filter",
-                     "filter_width", "seed", "threads", "update_seconds"):
+        for name in self.SHOWN:
             layout.prop(settings, name)
         layout.operator("gridtrace.write_farm_job", icon="NETWORK_DRIVE")
 
