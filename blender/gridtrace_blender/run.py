@@ -105,7 +105,7 @@ def export(scene, folder, shutter):
     try:
         scene.frame_start = int(np.floor(scene.frame_current + shutter[0])) - 1
         scene.frame_end = int(np.ceil(scene.frame_current + shutter[1])) + 1
-        result = bpy.ops.wm.usd_export(
+        result = _run_exporter(
             filepath=path, selected_objects_only=False, export_animation=True,
             export_materials=True, generate_preview_surface=True, generate_materialx_network=True,
             export_lights=True, export_cameras=True, convert_world_material=True, evaluation_mode="RENDER",
@@ -115,6 +115,23 @@ def export(scene, folder, shutter):
     if "FINISHED" not in result or not os.path.isfile(path):
         raise RenderFailed("gridtrace: Blender's USD exporter did not write the scene")
     return path
+
+
+def _run_exporter(**options):
+    """Blender's USD exporter. From a render started in Blender's interface the context may
+    lack a window, which the operator's poll wants: then it runs again with the first
+    window put in the context. Any failure is a report, never an exception."""
+    try:
+        return bpy.ops.wm.usd_export(**options)
+    except RuntimeError as first:
+        windows = bpy.context.window_manager.windows if bpy.context.window_manager else []
+        if bpy.app.background or not windows:
+            raise RenderFailed(f"gridtrace: Blender's USD exporter failed: {first}") from first
+        try:
+            with bpy.context.temp_override(window=windows[0]):
+                return bpy.ops.wm.usd_export(**options)
+        except RuntimeError as second:
+            raise RenderFailed(f"gridtrace: Blender's USD exporter failed: {second}") from second
 
 
 def _die_with_parent():
