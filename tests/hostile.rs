@@ -211,6 +211,22 @@ const CASES: &[(&str, Expect)] = &[
         Expect::Warning("image 0: is too large: decoding its 12000x12000 pixels needs 4.6 GB"),
     ),
     (
+        "zero_filled_indices.gltf",
+        Expect::Error("accessor 1 has no buffer view and 300000000 elements"),
+    ),
+    (
+        "zero_filled_sparse.gltf",
+        Expect::Error("accessor 0 has no buffer view and 300000000 elements"),
+    ),
+    (
+        "jpeg_bomb.gltf",
+        Expect::Warning("image 0: is too large: decoding its 20000x20000 pixels needs"),
+    ),
+    (
+        "rgba_png_bomb.gltf",
+        Expect::Warning("image 0: is too large: decoding its 16000x16000 pixels needs"),
+    ),
+    (
         "webp_bomb.gltf",
         Expect::Warning("image 0: is too large: decoding its 16383x16383 pixels needs 8.6 GB"),
     ),
@@ -221,6 +237,10 @@ const CASES: &[(&str, Expect)] = &[
     (
         "usd_dome_bomb.usda",
         Expect::Warning("dome texture 'big_rle.hdr' is too large: decoding its 12000x6000 pixels"),
+    ),
+    (
+        "usd_dome_exr_bomb.usda",
+        Expect::Warning("dome texture 'big_zip.exr' is too large: decoding its 16000x8000 pixels"),
     ),
     // Control characters from the file reach the terminal escaped.
     (
@@ -385,6 +405,41 @@ fn subdivision_and_motion_steps_stay_within_the_budget() {
     assert!(many < 2 * two, "64 steps take {many} bytes, 2 steps {two}");
 }
 
+/// Key times of an animation read at `--frame` are held to the zero-filled accessor rule as
+/// every other accessor is.
+#[test]
+fn an_animation_of_zero_filled_key_times_is_refused() {
+    let _serial = serial();
+    let out = tempfile::tempdir().unwrap();
+    let image = out.path().join("never.png");
+    let args = [
+        "zero_filled_animation.gltf",
+        "--frame",
+        "1",
+        "-o",
+        image.to_str().unwrap(),
+        "--width",
+        "16",
+        "--spp",
+        "1",
+        "-q",
+    ];
+    let run = run_limited(&args, &scenes());
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr.starts_with("error: ")
+            && run.stderr.contains("zero_filled_animation.gltf")
+            && run
+                .stderr
+                .contains("accessor 2 has no buffer view and 300000000 elements")
+            && run.stderr.lines().count() == 1,
+        "{}",
+        run.stderr
+    );
+    assert!(run.peak < MEMORY_LIMIT, "peak {} bytes", run.peak);
+    assert!(!image.exists());
+}
+
 /// One image file named by four spellings of its URI is decoded once.
 #[test]
 fn an_image_is_decoded_once_however_its_uri_is_spelt() {
@@ -411,6 +466,10 @@ fn environment_maps_too_large_or_cut_short_are_refused() {
         (
             "big_rle.hdr",
             "big_rle.hdr: environment map is too large: decoding its 12000x6000 pixels",
+        ),
+        (
+            "big_zip.exr",
+            "big_zip.exr: environment map is too large: decoding its 16000x8000 pixels",
         ),
         ("cut.hdr", "cut.hdr: environment map cannot be decoded"),
     ] {

@@ -370,15 +370,17 @@ def Xform "B" (
     make_memory_text_and_silent_cases(j)
 
 
-def grey_png(width, height):
-    """A grey PNG of zeros, `width`×`height`: a few hundred kilobytes that decode to
-    `width`·`height` bytes (and to 32 bytes a pixel on the way to a texture)."""
+def grey_png(width, height, channels=1):
+    """A PNG of zeros, `width`×`height`, grey (`channels` 1) or RGBA (4): a few hundred
+    kilobytes that decode to `width`·`height`·`channels` bytes (and to 32 bytes a pixel on
+    the way to a texture)."""
     def chunk(kind, data):
         return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
     compress = zlib.compressobj(9)
-    row = bytes(width + 1)  # filter byte 0, then the row
+    row = bytes(width * channels + 1)  # filter byte 0, then the row
     idat = b"".join(compress.compress(row) for _ in range(height)) + compress.flush()
-    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    colour_type = {1: 0, 4: 6}[channels]
+    header = struct.pack(">IIBBBBB", width, height, 8, colour_type, 0, 0, 0)
     return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", idat) + chunk(b"IEND", b"")
 
 
@@ -395,6 +397,58 @@ def rle_hdr(width, height):
             left -= n
     line = bytes([2, 2, width >> 8, width & 255]) + bytes(runs)
     return header + line * height
+
+
+def grey_jpeg(width, height):
+    """A baseline JPEG (ITU T.81) of one mid-grey channel, `width`×`height` (multiples of 8):
+    Huffman tables of one 1-bit code each make every 8×8 block two zero bits (DC difference
+    0, end of block), so 20000² pixels take 1.6 MB."""
+    def segment(marker, body):
+        return b"\xff" + bytes([marker]) + struct.pack(">H", len(body) + 2) + body
+    one_code = lambda table, symbol: bytes([table]) + bytes([1] + [0] * 15) + bytes([symbol])
+    blocks = (width // 8) * (height // 8)
+    return (b"\xff\xd8"
+            + segment(0xDB, b"\x00" + bytes([1] * 64))  # quantisation table 0
+            + segment(0xC0, struct.pack(">BHHB", 8, height, width, 1) + b"\x01\x11\x00")
+            + segment(0xC4, one_code(0x00, 0) + one_code(0x10, 0))  # DC: 0; AC: end of block
+            + segment(0xDA, b"\x01\x01\x00\x00\x3f\x00")
+            + bytes((2 * blocks + 7) // 8) + b"\xff\xd9")
+
+
+def black_zip_exr(width, height):
+    """An OpenEXR of black half-float RGB in ZIP blocks of 16 scanlines (OpenEXR file
+    layout: header, offset table, chunks): a few hundred kilobytes that decode to
+    `width`·`height`·6 bytes, and 40 bytes a pixel as an environment map."""
+    def attribute(name, kind, value):
+        return name + b"\0" + kind + b"\0" + struct.pack("<i", len(value)) + value
+    channels = b"".join(c + b"\0" + struct.pack("<iB3xii", 1, 0, 1, 1) for c in (b"B", b"G", b"R")) + b"\0"
+    window = struct.pack("<4i", 0, 0, width - 1, height - 1)
+    header = (b"\x76\x2f\x31\x01" + struct.pack("<i", 2)
+              + attribute(b"channels", b"chlist", channels)
+              + attribute(b"compression", b"compression", b"\x03")
+              + attribute(b"dataWindow", b"box2i", window)
+              + attribute(b"displayWindow", b"box2i", window)
+              + attribute(b"lineOrder", b"lineOrder", b"\x00")
+              + attribute(b"pixelAspectRatio", b"float", struct.pack("<f", 1))
+              + attribute(b"screenWindowCenter", b"v2f", struct.pack("<2f", 0, 0))
+              + attribute(b"screenWindowWidth", b"float", struct.pack("<f", 1))
+              + b"\0")
+    lines = 16
+    count = (height + lines - 1) // lines
+    # Zeros after the ZIP predictor: the first byte, then differences of 0 stored as 128.
+    def block(n):
+        size = n * width * 3 * 2
+        return zlib.compress(b"\0" + b"\x80" * (size - 1), 9)
+    full, chunks, offset = block(lines), [], len(header) + 8 * count
+    offsets = []
+    for k in range(count):
+        n = min(lines, height - k * lines)
+        data = full if n == lines else block(n)
+        chunk = struct.pack("<ii", k * lines, len(data)) + data
+        offsets.append(offset)
+        offset += len(chunk)
+        chunks.append(chunk)
+    return header + struct.pack(f"<{count}Q", *offsets) + b"".join(chunks)
 
 
 def flat_hdr(width, height):
@@ -452,6 +506,23 @@ def make_memory_text_and_silent_cases(j):
     del doc["accessors"][0]["bufferView"]
     doc["accessors"][0]["count"] = 300_000_000
     write_json(j("zero_filled_positions.gltf"), doc)
+    doc = gltf()
+    del doc["accessors"][1]["bufferView"]
+    doc["accessors"][1]["count"] = 300_000_000
+    write_json(j("zero_filled_indices.gltf"), doc)
+    # A sparse accessor over zeros sets one of its 3·10⁸ positions.
+    doc = gltf()
+    del doc["accessors"][0]["bufferView"]
+    doc["accessors"][0]["count"] = 300_000_000
+    doc["accessors"][0]["sparse"] = {"count": 1, "indices": {"bufferView": 1, "componentType": 5123},
+                                     "values": {"bufferView": 0}}
+    write_json(j("zero_filled_sparse.gltf"), doc)
+    # An animation sampler whose key times are 3·10⁸ zeros (read with --frame).
+    doc = gltf()
+    doc["accessors"].append({"componentType": 5126, "count": 300_000_000, "type": "SCALAR", "min": [0], "max": [0]})
+    doc["animations"] = [{"samplers": [{"input": 2, "output": 0}],
+                          "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}]
+    write_json(j("zero_filled_animation.gltf"), doc)
     # Image bombs: a 12000² grey PNG (about 150 kB) as a texture, in a .gltf and a .usdz.
     write(j("bomb.png"), grey_png(12000, 12000))
     write_json(j("png_bomb.gltf"), textured_gltf("bomb.png"))
@@ -460,6 +531,10 @@ def make_memory_text_and_silent_cases(j):
         z.write(j("bomb.png"), "bomb.png")
     write(j("bomb.webp"), webp_header(16383, 16383))
     write_json(j("webp_bomb.gltf"), textured_gltf("bomb.webp"))
+    write(j("bomb.jpg"), grey_jpeg(20000, 20000))
+    write_json(j("jpeg_bomb.gltf"), textured_gltf("bomb.jpg"))
+    write(j("bomb_rgba.png"), grey_png(16000, 16000, channels=4))
+    write_json(j("rgba_png_bomb.gltf"), textured_gltf("bomb_rgba.png"))
     # One image spelt four ways decodes once (tests/hostile.rs counts the textures).
     os.makedirs(j("sub"), exist_ok=True)
     write(j("t.png"), grey_png(4, 4))
@@ -480,6 +555,8 @@ def make_memory_text_and_silent_cases(j):
 }
 """
     write(j("usd_dome_bomb.usda"), usda(dome))
+    write(j("big_zip.exr"), black_zip_exr(16000, 8000))
+    write(j("usd_dome_exr_bomb.usda"), usda(dome.replace("big_rle.hdr", "big_zip.exr")))
     # Subdivision and motion steps under --max-memory: a 1,024-quad cage, and a 25,600-quad
     # mesh that moves (tests/hostile.rs gives the levels, steps and budget).
     write(j("usd_subdivision_cage.usda"), usda(grid_mesh(
