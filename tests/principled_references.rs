@@ -63,3 +63,17 @@ fn roughness_texture_and_normal_map_from_usd_match_cycles() {
 fn rough_glass_matches_cycles() {
     check("principled_glass", "glb", 2 * SPP);
 }
+
+/// A clear and a tinted single sheet of glass (one surface each, entered and never left),
+/// a closed yellow glass ball and a glass ball whose Metallic is a texture of 0, in front
+/// of an emitting backdrop: each crossing tints by √(base colour) and radiance is not
+/// scaled by 1/η², as in Cycles.
+#[test]
+fn glass_sheets_and_tinted_glass_match_cycles() {
+    check("principled_glass_tints", "glb", SPP);
+}
+
+#[test]
+fn glass_sheets_and_tinted_glass_from_usd_match_cycles() {
+    check("principled_glass_tints", "usdc", SPP);
+}

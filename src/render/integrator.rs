@@ -12,6 +12,7 @@ use super::aov::Features;
 use super::bsdf::Bsdf;
 use super::sampler::Sampler;
 use super::sampling::power_heuristic;
+use super::shading::valid_reflection_normal;
 use super::surface::{Surface, surface_at};
 use crate::accel::Ray;
 use crate::geometry::offset_ray_origin;
@@ -88,7 +89,6 @@ impl Renderer<'_> {
         // Distance along the path from the camera, for the depth layer.
         let mut path_length = 0.0f32;
         let mut beta = Vec3::ONE;
-        let mut eta_scale = 1.0f32;
         let mut arrival = Arrival::Specular;
         // Absorption coefficient of the glass volume the path is inside, if any.
         let mut medium: Option<Vec3> = None;
@@ -230,11 +230,20 @@ impl Renderer<'_> {
             } else {
                 1.0
             };
-            let ns = side * shading.normal;
-            let bsdf = match shading.coat_normal {
-                Some(coat) => shading.bsdf.with_coat_normal(ns, side * coat),
+            // Glossy lobes turn about a normal raised until mirror reflection stays above
+            // the surface (as Cycles does); the diffuse base and sheen keep the shading
+            // normal.
+            let ns_diffuse = side * shading.normal;
+            let ns = valid_reflection_normal(ng, wo, ns_diffuse);
+            let mut bsdf = match shading.coat_normal {
+                Some(coat) => shading
+                    .bsdf
+                    .with_coat_normal(ns, valid_reflection_normal(ng, wo, side * coat)),
                 None => shading.bsdf,
             };
+            if ns != ns_diffuse {
+                bsdf = bsdf.with_diffuse_normal(ns, ns_diffuse);
+            }
 
             // Sample a light for the next-event estimate. Punctual lights can only be found
             // this way, so even the BSDF-only estimator samples them.
@@ -255,7 +264,6 @@ impl Renderer<'_> {
                 break;
             }
             beta *= sample.weight;
-            eta_scale *= sample.eta_scale;
             if sample.is_transmission {
                 // Entering through the front face puts the path inside the volume.
                 medium =
@@ -277,14 +285,13 @@ impl Renderer<'_> {
             depth += 1;
             pass_throughs = 0;
 
-            // Possibly terminate the path with Russian roulette. The throughput is judged
-            // without the radiance scaling of refractions, which cancels on leaving glass;
-            // paths survive with the square root of it, as in Cycles
+            // Possibly terminate the path with Russian roulette. Paths survive with the
+            // square root of the throughput, as in Cycles
             // (`path_state_continuation_probability`): later than with the throughput
             // itself, which lowered the error at equal time by 10–25 % on the reference
             // scenes (tools/blender/efficiency.py).
             if depth >= ROULETTE_DEPTH {
-                let rr = (beta / eta_scale).max_element().sqrt();
+                let rr = beta.max_element().sqrt();
                 if rr < 1.0 {
                     let q = (1.0 - rr).clamp(0.05, 0.95);
                     if sampler.uniform() < q {
@@ -331,7 +338,7 @@ impl Renderer<'_> {
         if ls.radiance == Vec3::ZERO || (ng.dot(ls.wi) > 0.0) != (ns.dot(ls.wi) > 0.0) {
             return Vec3::ZERO;
         }
-        let f = bsdf.eval(ns, wo, ls.wi) * ns.dot(ls.wi).abs();
+        let f = bsdf.eval(ns, wo, ls.wi);
         if f == Vec3::ZERO {
             return Vec3::ZERO;
         }

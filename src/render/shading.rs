@@ -174,3 +174,70 @@ impl Renderer<'_> {
             .unwrap_or(n)
     }
 }
+
+/// The shading normal `n` raised towards the geometric normal `ng` (both on the side of
+/// `wo`) just enough that the mirror reflection of `wo` leaves the surface at least as
+/// steeply as min(0.9·cos θo, 0.01) above it; `n` itself when it already does. Normal maps
+/// and coarse smooth shading tilt normals away from the viewer, whose glossy lobes would
+/// otherwise reflect into the surface and render black. This is Cycles' rule
+/// (`ensure_valid_specular_reflection`, bsdf_util.h): in the plane of `ng` and `n`, with
+/// a = Ix² + Iz², b = 2(a + Iz·t), c = (Iz + t)², the raised normal's height solves
+/// 4a·Nz⁴ − 2b·Nz² + c = 0, the root chosen by the sign of Ix.
+pub fn valid_reflection_normal(ng: Vec3, wo: Vec3, n: Vec3) -> Vec3 {
+    let reflected = 2.0 * n.dot(wo) * n - wo;
+    let iz = wo.dot(ng).max(0.0);
+    let threshold = (0.9 * iz).min(0.01);
+    if ng.dot(reflected) >= threshold {
+        return n;
+    }
+    let x = (n - n.dot(ng) * ng).try_normalize().unwrap_or(n);
+    let ix = wo.dot(x);
+    let a = ix * ix + iz * iz;
+    let b = 2.0 * (a + iz * threshold);
+    let c = (threshold + iz) * (threshold + iz);
+    if a <= 0.0 {
+        return n;
+    }
+    let root = (b * b - 4.0 * a * c).max(0.0).sqrt();
+    let nz2 = (if ix < 0.0 { b + root } else { b - root }) * 0.25 / a;
+    let nx = (1.0 - nz2).max(0.0).sqrt();
+    (nx * x + nz2.max(0.0).sqrt() * ng)
+        .try_normalize()
+        .unwrap_or(ng)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The raised normal lifts the mirror reflection to the threshold and no further, stays
+    /// in the plane of the two normals, and leaves a normal that already reflects above the
+    /// surface alone.
+    #[test]
+    fn raised_normals_reflect_just_above_the_surface() {
+        let ng = Vec3::Z;
+        for (tilt_degrees, view_degrees) in [(45.0f32, 30.0f32), (15.0, 80.0), (60.0, 0.0)] {
+            let (tilt, view) = (tilt_degrees.to_radians(), view_degrees.to_radians());
+            // The normal leans away from the viewer, who looks from +x.
+            let n = Vec3::new(-tilt.sin(), 0.0, tilt.cos());
+            let wo = Vec3::new(view.sin(), 0.0, view.cos());
+            let raised = valid_reflection_normal(ng, wo, n);
+            let reflected = 2.0 * raised.dot(wo) * raised - wo;
+            let threshold = (0.9 * wo.z).min(0.01);
+            let before = (2.0 * n.dot(wo) * n - wo).z;
+            if before >= threshold {
+                assert_eq!(raised, n);
+                continue;
+            }
+            assert!((raised.length() - 1.0).abs() < 1e-5);
+            assert!(raised.y.abs() < 1e-6, "{raised}");
+            assert!(
+                (reflected.z - threshold).abs() < 1e-3,
+                "tilt {tilt_degrees}°, view {view_degrees}°: {reflected}"
+            );
+            assert!(raised.dot(wo) > 0.0);
+        }
+        let straight = Vec3::new(0.1, 0.0, 1.0).normalize();
+        assert_eq!(valid_reflection_normal(ng, Vec3::Z, straight), straight);
+    }
+}

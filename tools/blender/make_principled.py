@@ -18,6 +18,8 @@ clamping, no denoising, 64 bounces, black world).
   KHR_materials_sheen is Charlie's, which gridtrace follows; see docs/manual/materials.md.)
 - principled_textured: a metal panel whose roughness comes from a texture and whose normal from
   a normal map.
+- principled_glass_tints: single clear and tinted glass sheets, a closed yellow glass ball and
+  a glass ball whose Metallic is a texture of 0, in front of an emitting backdrop.
 - principled_glass: a rough glass ball (0.2). Blender's USD exporter writes no transmission
   into its UsdPreviewSurface, so this scene's .usdc is exported with the exporter's MaterialX
   network on, whose OpenPBR surface carries `transmission_weight`.
@@ -136,13 +138,46 @@ def build_textured(scene):
         uv.data[loop.index].uv = coord
 
 
+def build_glass_tints(scene):
+    """Glass as real assets use it, in front of a bright backdrop: a clear and a tinted
+    single sheet (a window pane modelled as one surface), a closed yellow glass ball, and a
+    clear glass ball whose Metallic comes from a texture of 0 (the glTF exporter writes
+    metallicFactor 1 with a metallic-roughness texture)."""
+    room(scene)
+    backdrop = principled("Backdrop", (0.0, 0.0, 0.0), emission=(1.0, 1.0, 1.0), strength=0.8)
+    quad("Backdrop", [(-4, 1.4, 0), (4, 1.4, 0), (4, 1.4, 4), (-4, 1.4, 4)], backdrop)
+
+    def glass(name, colour, roughness=0.0):
+        mat = blender_default(name, colour, Roughness=roughness)
+        mat.node_tree.nodes["Principled BSDF"].inputs["Transmission Weight"].default_value = 1.0
+        return mat
+
+    for name, colour, x in (("ClearSheet", (1.0, 1.0, 1.0), -1.15), ("TintedSheet", (0.25, 0.5, 1.0), -0.35)):
+        quad(name, [(x - 0.35, -0.6, 0.2), (x + 0.35, -0.6, 0.2), (x + 0.35, -0.6, 1.4), (x - 0.35, -0.6, 1.4)],
+             glass(name, colour))
+    sphere("YellowBall", glass("YellowGlass", (1.0, 0.9, 0.1)), 0.35, (0.45, -0.3, 0.6))
+    textured_glass = glass("TexturedMetallicGlass", (1.0, 1.0, 1.0))
+    nodes, links = textured_glass.node_tree.nodes, textured_glass.node_tree.links
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = make_image("metallic_zero", 4, lambda u, v: (1.0, 0.0, 0.0, 1.0), "Non-Color")
+    tex.interpolation = "Closest"
+    separate = nodes.new("ShaderNodeSeparateColor")
+    links.new(tex.outputs["Color"], separate.inputs["Color"])
+    links.new(separate.outputs["Blue"], nodes["Principled BSDF"].inputs["Metallic"])
+    links.new(separate.outputs["Green"], nodes["Principled BSDF"].inputs["Roughness"])
+    sphere("TexturedBall", textured_glass, 0.35, (1.2, -0.3, 0.6))
+
+
 # name -> (builder, total reference samples)
 SCENE_TABLE = {
     "principled_metals": (build_metals, 2048),
     "principled_plastics": (build_plastics, 2048),
     "principled_textured": (build_textured, 2048),
     "principled_glass": (build_glass, 4096),
+    "principled_glass_tints": (build_glass_tints, 2048),
 }
+# Glass reaches USD only through the exporter's MaterialX network.
+MATERIALX = {"principled_glass", "principled_glass_tints"}
 
 
 def main():
@@ -153,7 +188,7 @@ def main():
         scene = reset()
         build(scene)
         export(os.path.join(SCENES, f"{name}.glb"))
-        export_usd(os.path.join(SCENES, f"{name}.usdc"), materialx=name == "principled_glass")
+        export_usd(os.path.join(SCENES, f"{name}.usdc"), materialx=name in MATERIALX)
         if not args.export_only:
             render_reference(scene, name, args.samples or samples)
     return 0

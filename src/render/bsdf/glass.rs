@@ -4,7 +4,10 @@
 //!
 //! Directions are local with `wo` above the surface (+Z on `wo`'s side); `eta` is the index
 //! of the side `wo` is not on over the index of `wo`'s side. Radiance crossing the interface
-//! is scaled by 1/η² (Veach 1997, §5.2), which [`GlassLobe::eval`] includes.
+//! is not scaled by 1/η² (Veach 1997, §5.2): Cycles leaves it out (its `bsdf_microfacet.h`
+//! transmits (1 − F)·tint), and so does gridtrace, so that a single sheet of glass (a window
+//! pane modelled as one surface, which enters glass and never leaves it) passes 1 − F as in
+//! Cycles. Through closed glass the factors of entry and exit cancel, so nothing else changes.
 //!
 //! Single scattering loses the light that masking stops; as Cycles does, the rough lobe is
 //! divided by its energy albedo E(μo, roughness, η) from a table (Turquin 2019 with F = 1:
@@ -26,7 +29,7 @@ pub struct GlassLobe {
     roughness: f32,
     /// η_other / η_wo.
     eta: f32,
-    /// Colour of transmitted light (reflection is white, as glTF defines).
+    /// Colour of light at each crossing (reflection is white, as glTF defines).
     tint: Vec3,
 }
 
@@ -58,11 +61,6 @@ impl GlassLobe {
     /// True when smooth.
     pub fn is_delta(&self) -> bool {
         self.ggx.is_none()
-    }
-
-    /// η_other / η_wo.
-    pub fn eta(&self) -> f32 {
-        self.eta
     }
 
     /// The microfacet normal of a pair of directions, on `wo`'s side, and whether the pair
@@ -97,9 +95,8 @@ impl GlassLobe {
             return Vec3::splat(dg * f / (4.0 * wo.z * wi.z));
         }
         let denom = wi.dot(h) + wo.dot(h) / self.eta;
-        let value = dg * (1.0 - f) * (wi.dot(h) * wo.dot(h)).abs()
-            / (wi.z.abs() * wo.z * denom * denom)
-            / (self.eta * self.eta);
+        let value =
+            dg * (1.0 - f) * (wi.dot(h) * wo.dot(h)).abs() / (wi.z.abs() * wo.z * denom * denom);
         self.tint * value
     }
 
@@ -149,7 +146,7 @@ impl GlassLobe {
         let wi = refract(wo, Vec3::Z, 1.0 / self.eta)?;
         Some(DeltaSample {
             wi,
-            value: self.tint * ((1.0 - f) / (self.eta * self.eta)),
+            value: self.tint * (1.0 - f),
             probability: 1.0 - f,
             is_transmission: true,
         })
@@ -182,12 +179,11 @@ mod tests {
         assert!((refl.value.x / refl.probability - 1.0).abs() < 1e-6);
         let trans = glass.sample_delta(wo, f * 1.01).unwrap();
         assert!(trans.is_transmission && trans.wi.z < 0.0);
-        assert!((trans.value.x / trans.probability - 1.0 / 2.25).abs() < 1e-6);
+        assert!((trans.value.x / trans.probability - 1.0).abs() < 1e-6);
     }
 
     /// Reflection and transmission of a rough interface, compensated, conserve energy:
-    /// ∫(f·|cos|) over the sphere is one (radiance scaling undone), at every roughness, on
-    /// both sides.
+    /// ∫(f·|cos|) over the sphere is one, at every roughness, on both sides.
     #[test]
     fn rough_interface_conserves_energy() {
         // Inside a dense medium total internal reflection makes the albedo change fast
@@ -208,8 +204,7 @@ mod tests {
                     continue;
                 };
                 let pdf = glass.pdf(wo, wi);
-                let scale = if wi.z < 0.0 { eta * eta } else { 1.0 };
-                sum += f64::from(glass.eval(wo, wi).x * wi.z.abs() * scale / pdf);
+                sum += f64::from(glass.eval(wo, wi).x * wi.z.abs() / pdf);
             }
             let e = sum / n as f64;
             assert!(

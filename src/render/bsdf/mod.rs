@@ -7,7 +7,7 @@
 //!  └ sheen ─ Charlie sheen
 //!     └ metallic · GGX conductor (F0 = base colour)
 //!       + (1 − metallic)(1 − transmission) · [GGX dielectric layer over Lambertian base]
-//!       + (1 − metallic) · transmission · rough or smooth glass (tinted by base colour)
+//!       + (1 − metallic) · transmission · rough or smooth glass (√base colour per crossing)
 //! ```
 //!
 //! Each layer passes to what lies beneath it the energy it does not reflect towards the
@@ -69,6 +69,10 @@ pub struct Bsdf {
     coat_frame: Option<Frame>,
     /// Sheen colour and α, between the coat and the rest.
     sheen: Option<(Vec3, f32)>,
+    /// The cosine lobes' (diffuse base and sheen) own normal, when the shading normal has
+    /// been raised for the glossy lobes ([`Bsdf::with_diffuse_normal`]): world space, and
+    /// as a frame in the local frame of the glossy normal.
+    diffuse_normal: Option<(Vec3, Frame)>,
 }
 
 /// A direction drawn from a BSDF.
@@ -84,8 +88,6 @@ pub struct BsdfSample {
     pub is_delta: bool,
     /// True when `wi` crosses the surface.
     pub is_transmission: bool,
-    /// The factor radiance is scaled by at a refraction, (η_i/η_t)²; 1 otherwise.
-    pub eta_scale: f32,
 }
 
 /// The ways [`Bsdf::sample`] draws a direction.
@@ -135,9 +137,14 @@ impl Bsdf {
             let fresnel = Fresnel::Schlick { f0: base, f90: 1.0 };
             (SpecularLobe::new(roughness, fresnel), w)
         });
+        // Each crossing tints by √(base colour), as Cycles' Principled BSDF does
+        // (`svm/closure.h`: the glass's transmission tint is sqrt(base colour)), so light
+        // through a closed object is tinted by the base colour once, and a single sheet by
+        // its square root.
         let eta = if front { pbr.ior } else { 1.0 / pbr.ior };
+        let tint = base.powf(0.5);
         let glass = positive((1.0 - metallic) * transmission)
-            .map(|w| (GlassLobe::new(roughness, eta, base), w));
+            .map(|w| (GlassLobe::new(roughness, eta, tint), w));
         let coat = positive(pbr.clearcoat.min(1.0)).map(|c| {
             let fresnel = Fresnel::Dielectric {
                 eta: COAT_IOR,
@@ -159,6 +166,7 @@ impl Bsdf {
             coat,
             coat_frame: None,
             sheen,
+            diffuse_normal: None,
         }
     }
 
@@ -170,6 +178,23 @@ impl Bsdf {
             self.coat_frame = local.try_normalize().map(Frame::from_normal);
         }
         self
+    }
+
+    /// The same BSDF with its glossy lobes around `n` (a shading normal raised so that
+    /// mirror reflection stays above the surface, [`crate::render::shading::valid_reflection_normal`])
+    /// and its diffuse base and sheen around the unraised `diffuse_normal`, as Cycles'
+    /// Principled BSDF sets them up (`svm/closure.h`: the diffuse closure keeps N).
+    pub fn with_diffuse_normal(mut self, n: Vec3, diffuse_normal: Vec3) -> Bsdf {
+        let local = Frame::from_normal(n).to_local(diffuse_normal);
+        if let Some(local) = local.try_normalize() {
+            self.diffuse_normal = Some((diffuse_normal, Frame::from_normal(local)));
+        }
+        self
+    }
+
+    /// A direction of the glossy frame in the cosine lobes' frame.
+    fn in_diffuse_frame(&self, w: Vec3) -> Vec3 {
+        self.diffuse_normal.map_or(w, |(_, f)| f.to_local(w))
     }
 
     /// A direction of the shading frame in the coat's frame.
@@ -249,12 +274,14 @@ impl Bsdf {
             factor *= coat.transmitted(self.in_coat_frame(wo).z.max(0.0));
         }
         if let Some((colour, roughness)) = self.sheen {
-            factor *= sheen_transmitted(colour, roughness, wo.z);
+            let mu = self.in_diffuse_frame(wo).z.max(0.0);
+            factor *= sheen_transmitted(colour, roughness, mu);
         }
         factor
     }
 
-    /// f(wo, wi) in the local frame, for every non-delta lobe.
+    /// f(wo, wi)·|cos θi| in the local frame, for every non-delta lobe, each lobe's
+    /// cosine taken about its own normal.
     fn eval_local(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if wo.z <= 0.0 {
             return Vec3::ZERO;
@@ -262,28 +289,33 @@ impl Bsdf {
         let beneath = self.beneath_top(wo);
         let mut f = Vec3::ZERO;
         if let Some((glass, w)) = &self.glass {
-            f += beneath * glass.eval(wo, wi) * *w;
+            f += beneath * glass.eval(wo, wi) * (*w * wi.z.abs());
         }
         if wi.z <= 0.0 {
             return f;
         }
         let coat_wo = self.in_coat_frame(wo);
         if let Some(coat) = &self.coat {
-            f += coat.eval(coat_wo, self.in_coat_frame(wi));
+            f += coat.eval(coat_wo, self.in_coat_frame(wi)) * wi.z;
         }
+        let (diffuse_wo, diffuse_wi) = (self.in_diffuse_frame(wo), self.in_diffuse_frame(wi));
+        let diffuse_cos = diffuse_wi.z.max(0.0);
         if let Some((colour, roughness)) = self.sheen {
             let factor = self
                 .coat
                 .map_or(Vec3::ONE, |c| c.transmitted(coat_wo.z.max(0.0)));
-            f += factor * colour * charlie_brdf(roughness * roughness, wo, wi);
+            if diffuse_wo.z > 0.0 && diffuse_cos > 0.0 {
+                let sheen = charlie_brdf(roughness * roughness, diffuse_wo, diffuse_wi);
+                f += factor * colour * (sheen * diffuse_cos);
+            }
         }
         if let Some((metal, w)) = &self.metal {
-            f += beneath * metal.eval(wo, wi) * *w;
+            f += beneath * metal.eval(wo, wi) * (*w * wi.z);
         }
-        let mut base = self.diffuse * FRAC_1_PI;
+        let mut base = self.diffuse * (FRAC_1_PI * diffuse_cos);
         if let Some((specular, w)) = &self.specular {
             base *= specular.transmitted(wo.z);
-            f += beneath * specular.eval(wo, wi) * *w;
+            f += beneath * specular.eval(wo, wi) * (*w * wi.z);
         }
         f + beneath * base
     }
@@ -305,7 +337,8 @@ impl Bsdf {
             top = 1.0 - coat;
         }
         if let Some((colour, roughness)) = self.sheen {
-            let e = colour.max_element() * albedo::tables().sheen(mu_o, roughness);
+            let mu = self.in_diffuse_frame(wo).z.max(0.0);
+            let e = colour.max_element() * albedo::tables().sheen(mu, roughness);
             cosine += top * e;
             top *= 1.0 - e;
         }
@@ -337,7 +370,9 @@ impl Bsdf {
                 continue;
             }
             let p = match strategy {
-                Strategy::Cosine => wi.z.max(0.0) * FRAC_1_PI,
+                // Cosine lobes reflect only above both their normal and the glossy one.
+                Strategy::Cosine if wi.z > 0.0 => self.in_diffuse_frame(wi).z.max(0.0) * FRAC_1_PI,
+                Strategy::Cosine => 0.0,
                 Strategy::Coat => self.coat.map_or(0.0, |c| {
                     c.pdf_visible(self.in_coat_frame(wo), self.in_coat_frame(wi))
                 }),
@@ -350,12 +385,13 @@ impl Bsdf {
         pdf / total
     }
 
-    /// f(wo, wi) over the non-delta lobes; zero for delta lobes.
+    /// f(wo, wi)·|cos θi| over the non-delta lobes (each lobe's cosine about its own
+    /// normal); zero for delta lobes.
     pub fn eval(&self, n: Vec3, wo: Vec3, wi: Vec3) -> Vec3 {
         if self.is_lambertian() {
-            let above = n.dot(wo) > 0.0 && n.dot(wi) > 0.0;
-            return if above {
-                self.diffuse * FRAC_1_PI
+            let cos = self.diffuse_normal.map_or(n, |(d, _)| d).dot(wi);
+            return if n.dot(wo) > 0.0 && n.dot(wi) > 0.0 && cos > 0.0 {
+                self.diffuse * (FRAC_1_PI * cos)
             } else {
                 Vec3::ZERO
             };
@@ -368,10 +404,11 @@ impl Bsdf {
     pub fn pdf(&self, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
         if self.is_lambertian() {
             let black = self.diffuse == Vec3::ZERO || n.dot(wo) <= 0.0;
-            return if black {
+            let d = self.diffuse_normal.map_or(n, |(d, _)| d);
+            return if black || n.dot(wi) <= 0.0 {
                 0.0
             } else {
-                n.dot(wi).max(0.0) * FRAC_1_PI
+                d.dot(wi).max(0.0) * FRAC_1_PI
             };
         }
         let frame = Frame::from_normal(n);
@@ -391,13 +428,17 @@ impl Bsdf {
         if self.is_lambertian() {
             let wi = cosine_hemisphere(u);
             let pdf = wi.z * FRAC_1_PI;
-            return (pdf > 0.0 && self.diffuse != Vec3::ZERO).then(|| BsdfSample {
-                wi: frame.to_world(wi),
+            let wi = match self.diffuse_normal {
+                Some((d, _)) => Frame::from_normal(d).to_world(wi),
+                None => frame.to_world(wi),
+            };
+            let above = pdf > 0.0 && n.dot(wi) > 0.0;
+            return (above && self.diffuse != Vec3::ZERO).then(|| BsdfSample {
+                wi,
                 weight: self.diffuse,
                 pdf,
                 is_delta: false,
                 is_transmission: false,
-                eta_scale: 1.0,
             });
         }
         let weights = self.strategy_weights(wo);
@@ -422,18 +463,19 @@ impl Bsdf {
         let u_rest = (target / (probability * total)).clamp(0.0, 1.0 - f32::EPSILON);
         let delta = self.sample_delta(chosen, wo, u_rest);
         if let Some((wi, value, p, is_transmission)) = delta {
-            let scale = self.glass.map_or(1.0, |(g, _)| 1.0 / (g.eta() * g.eta()));
             return Some(BsdfSample {
                 wi: frame.to_world(wi),
                 weight: value / (p * probability),
                 pdf: p * probability,
                 is_delta: true,
                 is_transmission,
-                eta_scale: if is_transmission { scale } else { 1.0 },
             });
         }
         let wi = match chosen {
-            Strategy::Cosine => Some(cosine_hemisphere(u)),
+            Strategy::Cosine => Some(cosine_hemisphere(u)).map(|wi| {
+                self.diffuse_normal
+                    .map_or(wi, |(_, frame)| frame.to_world(wi))
+            }),
             Strategy::Coat => self
                 .coat
                 .and_then(|c| c.sample_visible(self.in_coat_frame(wo), u))
@@ -448,17 +490,12 @@ impl Bsdf {
             return None;
         }
         let is_transmission = wi.z < 0.0;
-        let eta_scale = match self.glass {
-            Some((g, _)) if is_transmission => 1.0 / (g.eta() * g.eta()),
-            _ => 1.0,
-        };
         Some(BsdfSample {
             wi: frame.to_world(wi),
-            weight: f * (wi.z.abs() / pdf),
+            weight: f / pdf,
             pdf,
             is_delta: false,
             is_transmission,
-            eta_scale,
         })
     }
 
