@@ -433,7 +433,7 @@ impl Bsdf {
                 None => frame.to_world(wi),
             };
             let above = pdf > 0.0 && n.dot(wi) > 0.0;
-            return (above && self.diffuse != Vec3::ZERO).then(|| BsdfSample {
+            return (above && self.diffuse != Vec3::ZERO).then_some(BsdfSample {
                 wi,
                 weight: self.diffuse,
                 pdf,
