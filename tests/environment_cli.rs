@@ -82,6 +82,50 @@ fn models_without_lights_or_camera_render_visibly_with_a_note() {
     }
 }
 
+/// A product model whose only emitters are its headlights (exported by Blender with a
+/// camera, no lamps and no world; tools/blender/make_product.py) is lit by the studio light
+/// with a note saying why, since the camera sees mostly background; `--environment none`
+/// leaves only the headlights. The Cornell box, lit by its ceiling panel with the camera
+/// seeing walls everywhere, stays as it is.
+#[test]
+fn product_models_with_small_emitters_get_the_studio_light_and_rooms_do_not() {
+    let dir = tempfile::tempdir().unwrap();
+    for file in ["product_emitters.glb", "product_emitters.usdc"] {
+        let (err, pixels) = render(dir.path(), file, "product.exr", &[]);
+        assert!(
+            err.lines().any(|l| l.starts_with("note: ")
+                && l.contains("only emissive surfaces light the scene")
+                && l.contains("% of the view is empty background")
+                && l.contains("--environment none")),
+            "{file}: {err}"
+        );
+        let covered: Vec<[f32; 4]> = pixels.iter().copied().filter(|p| p[3] == 1.0).collect();
+        assert!(mean(&covered) > 0.1, "{file}: the model is dark");
+        let (err, dark) = render(dir.path(), file, "dark.exr", &["--environment", "none"]);
+        assert!(!err.contains("studio"), "{file}: {err}");
+        let lit = dark.iter().filter(|p| p[0] + p[1] + p[2] > 0.0).count();
+        assert!(
+            lit < dark.len() / 10,
+            "{file}: {lit} pixels lit without the studio"
+        );
+    }
+    let cornell = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell_box.glb");
+    let out = gridtrace(
+        &[
+            cornell.to_str().unwrap(),
+            "-o",
+            "cornell.exr",
+            "--width",
+            "16",
+            "--spp",
+            "1",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("studio"), "{}", stderr(&out));
+}
+
 #[test]
 fn environment_file_strength_rotation_and_hiding() {
     let dir = tempfile::tempdir().unwrap();

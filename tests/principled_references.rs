@@ -77,3 +77,25 @@ fn glass_sheets_and_tinted_glass_match_cycles() {
 fn glass_sheets_and_tinted_glass_from_usd_match_cycles() {
     check("principled_glass_tints", "usdc", SPP);
 }
+
+/// Floor panels normal-mapped 15° and 45° away from the camera (the 45° one seen from below
+/// its normal's horizon) and a coarse smooth-shaded metal ball: glossy lobes turn about a
+/// normal raised until reflection stays above the surface, the diffuse base keeps the
+/// mapped normal and is shadowed by the bump terminator term, as in Cycles.
+#[test]
+fn normals_facing_away_match_cycles() {
+    check("principled_normals", "glb", SPP);
+}
+
+#[test]
+fn normals_facing_away_from_usd_match_cycles() {
+    check("principled_normals", "usdc", SPP);
+}
+
+/// Dark plastic with a black, a red and a white Specular Tint (glTF's specular colour): a
+/// black tint keeps the grazing Fresnel rise, as in Cycles. Blender's USD exporter writes
+/// no specular tint, so only the .glb is compared.
+#[test]
+fn specular_tints_match_cycles() {
+    check("principled_specular", "glb", SPP);
+}

@@ -46,8 +46,19 @@ pub struct EnvironmentSetting {
     pub hidden: bool,
 }
 
+/// The share of the view that must be empty background for a scene lit only by its own
+/// emissive surfaces to get the default studio light too (see
+/// [`crate::render::empty_view_share`]): an object on nothing, not a lit interior.
+pub const OBJECT_ON_NOTHING: f32 = 0.5;
+
 /// Sets the scene's environment as the options say, and says what it became.
-pub fn apply_environment(scene: &mut Scene, args: &EnvironmentArgs) -> Result<EnvironmentSetting> {
+/// `object_on_nothing`: the scene is lit only by emissive surfaces and the camera sees
+/// mostly background, so it gets the studio light as a scene without emitters does.
+pub fn apply_environment(
+    scene: &mut Scene,
+    args: &EnvironmentArgs,
+    object_on_nothing: bool,
+) -> Result<EnvironmentSetting> {
     let source = match &args.environment {
         Some(EnvironmentChoice::None) => {
             scene.environment = None;
@@ -65,7 +76,9 @@ pub fn apply_environment(scene: &mut Scene, args: &EnvironmentArgs) -> Result<En
                 sha256,
             }
         }
-        None if !scene.has_emitters() && scene.instanced_triangle_count() > 0 => {
+        None if (!scene.has_emitters() || object_on_nothing)
+            && scene.instanced_triangle_count() > 0 =>
+        {
             scene.environment = Some(Environment::studio());
             EnvironmentSource::Studio
         }
@@ -88,10 +101,18 @@ pub fn apply_environment(scene: &mut Scene, args: &EnvironmentArgs) -> Result<En
     })
 }
 
-/// The note that says the default studio light was chosen, and how to choose another.
-pub fn studio_note(scene_path: &Path) -> String {
+/// The note that says the default studio light was chosen, and how to choose another;
+/// `empty_share` when the scene's emissive surfaces were its only light.
+pub fn studio_note(scene_path: &Path, empty_share: Option<f32>) -> String {
+    let why = match empty_share {
+        None => "the scene has no lights".to_string(),
+        Some(share) => format!(
+            "only emissive surfaces light the scene and {:.0} % of the view is empty background",
+            100.0 * share
+        ),
+    };
     format!(
-        "note: {}: the scene has no lights; lighting it with the default studio environment \
+        "note: {}: {why}; lighting it with the default studio environment \
          (--environment FILE.hdr or R,G,B for your own, --environment none for black)",
         scene_path.display()
     )

@@ -31,9 +31,12 @@ pub fn triangulate(polygon: &[Vec3]) -> Option<Vec<[usize; 3]>> {
     let convex = (0..n).all(|i| convex_at(polygon[i], polygon[(i + 1) % n], polygon[(i + 2) % n]));
     if n == 4 && convex {
         // A convex quad splits along its shorter diagonal: the closer fit to a curved
-        // (non-planar) quad, and the same split whichever corner the quad starts at.
-        let short_02 =
-            polygon[0].distance_squared(polygon[2]) <= polygon[1].distance_squared(polygon[3]);
+        // (non-planar) quad, and the same split whichever corner the quad starts at. When
+        // the diagonals are equal to 0.1 % (the isosceles trapezoids of a UV sphere or a
+        // cylinder) neither fits better, and the quad splits from its first corner as
+        // Blender does for Cycles, so that smooth shading interpolates as in Blender.
+        let short_02 = polygon[0].distance_squared(polygon[2])
+            <= polygon[1].distance_squared(polygon[3]) * 1.002;
         return Some(if short_02 {
             vec![[0, 1, 2], [0, 2, 3]]
         } else {

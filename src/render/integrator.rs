@@ -244,6 +244,9 @@ impl Renderer<'_> {
             if ns != ns_diffuse {
                 bsdf = bsdf.with_diffuse_normal(ns, ns_diffuse);
             }
+            if shading.normal != s.shading_normal {
+                bsdf = bsdf.with_bump_shadowing(ns, s.shading_normal);
+            }
 
             // Sample a light for the next-event estimate. Punctual lights can only be found
             // this way, so even the BSDF-only estimator samples them.

@@ -119,6 +119,14 @@ impl Scene {
             })
     }
 
+    /// True when emissive surfaces are the only light: no lamps and no (or a black)
+    /// environment.
+    pub fn lit_only_by_surfaces(&self) -> bool {
+        self.lights.is_empty()
+            && self.environment.as_ref().is_none_or(|e| e.is_black())
+            && self.has_emitters()
+    }
+
     /// True when some geometry moves or deforms during the shutter.
     pub fn has_moving_geometry(&self) -> bool {
         self.instances

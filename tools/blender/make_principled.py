@@ -20,6 +20,9 @@ clamping, no denoising, 64 bounces, black world).
   a normal map.
 - principled_glass_tints: single clear and tinted glass sheets, a closed yellow glass ball and
   a glass ball whose Metallic is a texture of 0, in front of an emitting backdrop.
+- principled_normals: floor panels normal-mapped 15° and 45° away from the camera, and a
+  coarse smooth-shaded metal ball.
+- principled_specular: dark plastic spheres with a black, a red and a white Specular Tint.
 - principled_glass: a rough glass ball (0.2). Blender's USD exporter writes no transmission
   into its UsdPreviewSurface, so this scene's .usdc is exported with the exporter's MaterialX
   network on, whose OpenPBR surface carries `transmission_weight`.
@@ -28,6 +31,8 @@ clamping, no denoising, 64 bounces, black world).
 import math
 import os
 import sys
+
+import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from make_cornell import export, principled, quad, reset, sphere  # noqa: E402
@@ -168,6 +173,46 @@ def build_glass_tints(scene):
     sphere("TexturedBall", textured_glass, 0.35, (1.2, -0.3, 0.6))
 
 
+def build_normals(scene):
+    """Shading normals that face away from the viewer: two floor panels whose normal maps
+    lean 15° and 45° away from the camera (the camera sees the 45° panel from below its
+    tilted normal's horizon), and a coarse smooth-shaded metal ball, whose interpolated
+    normals turn away from the camera along its outline."""
+    room(scene)
+    for name, degrees, x0 in (("Tilt15", 15, -1.7), ("Tilt45", 45, 0.1)):
+        t = math.radians(degrees)
+        # Tangent space: +Y follows the V coordinate, which runs away from the camera.
+        texel = (0.5, 0.5 + 0.5 * math.sin(t), 0.5 + 0.5 * math.cos(t), 1.0)
+        mat = blender_default(name, (0.8, 0.7, 0.5))
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        tex = nodes.new("ShaderNodeTexImage")
+        tex.image = make_image(f"normal_{degrees}", 4, lambda u, v, texel=texel: texel, "Non-Color")
+        tex.interpolation = "Closest"
+        normal_map = nodes.new("ShaderNodeNormalMap")
+        links.new(tex.outputs["Color"], normal_map.inputs["Color"])
+        links.new(normal_map.outputs["Normal"], nodes["Principled BSDF"].inputs["Normal"])
+        obj = quad(name, [(x0, -2.0, 0.01), (x0 + 1.6, -2.0, 0.01), (x0 + 1.6, 0.5, 0.01), (x0, 0.5, 0.01)], mat)
+        uv = obj.data.uv_layers.new(name="UVMap")
+        for loop, coord in zip(obj.data.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
+            uv.data[loop.index].uv = coord
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=10, ring_count=6, radius=0.45, location=(0.0, 0.9, 0.6))
+    ball = bpy.context.active_object
+    ball.name = "CoarseBall"
+    bpy.ops.object.shade_smooth()
+    ball.data.materials.append(blender_default("CoarseMetal", (0.9, 0.9, 0.92), Metallic=1.0, Roughness=0.3))
+
+
+def build_specular(scene):
+    """Specular Tint (glTF's specular colour): black, red and white on the same dark
+    plastic; a black tint still reflects at grazing angles in Cycles."""
+    room(scene)
+    for name, tint, x in (("TintBlack", (0.0, 0.0, 0.0), -1.1), ("TintRed", (1.0, 0.2, 0.2), 0.0),
+                          ("TintWhite", (1.0, 1.0, 1.0), 1.1)):
+        mat = blender_default(name, (0.05, 0.05, 0.06), Roughness=0.25)
+        mat.node_tree.nodes["Principled BSDF"].inputs["Specular Tint"].default_value = tint + (1.0,)
+        sphere(name, mat, 0.5, (x, 0.0, 0.5))
+
+
 # name -> (builder, total reference samples)
 SCENE_TABLE = {
     "principled_metals": (build_metals, 2048),
@@ -175,6 +220,8 @@ SCENE_TABLE = {
     "principled_textured": (build_textured, 2048),
     "principled_glass": (build_glass, 4096),
     "principled_glass_tints": (build_glass_tints, 2048),
+    "principled_normals": (build_normals, 2048),
+    "principled_specular": (build_specular, 2048),
 }
 # Glass reaches USD only through the exporter's MaterialX network.
 MATERIALX = {"principled_glass", "principled_glass_tints"}

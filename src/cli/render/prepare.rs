@@ -8,7 +8,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use super::super::args::Args;
 use super::super::camera::{CameraPick, camera_label, image_size, with_depth_of_field};
 use super::super::environment::{
-    EnvironmentSetting, EnvironmentSource, apply_environment, studio_note,
+    EnvironmentSetting, EnvironmentSource, OBJECT_ON_NOTHING, apply_environment, studio_note,
 };
 use super::super::identity::IdentityInputs;
 use super::super::inspect::describe;
@@ -18,7 +18,7 @@ use crate::limits::check_memory;
 use crate::load::access::folder_of;
 use crate::load::load_scene_with;
 use crate::record::{sha256_file, sha256_files};
-use crate::render::{Film, RenderSettings, Strategy};
+use crate::render::{Film, RenderSettings, Strategy, empty_view_share};
 use crate::scene::{Camera, Scene};
 
 /// A scene ready to render, and how.
@@ -54,7 +54,7 @@ impl Prepared {
 /// The `--inspect` report: the scene as loaded, with its environment, and its warnings.
 pub fn describe_for_inspection(args: &Args, request: &Request) -> Result<String> {
     let mut loaded = load_scene_with(request.scene_path, &request.load_options)?;
-    apply_environment(&mut loaded.scene, &args.world)?;
+    apply_environment(&mut loaded.scene, &args.world, false)?;
     Ok(describe(&loaded.scene, &loaded.warnings))
 }
 
@@ -96,10 +96,15 @@ pub fn prepare(args: &Args, plan: &Plan) -> Result<Prepared> {
             crate::scene::MAX_COORDINATE
         ));
     }
-    let environment = apply_environment(&mut scene, &args.world)?;
-    check_contents(args, plan, &scene, &environment)?;
     let camera = pick?.camera(&scene, args.view.width, args.view.height)?;
     let (camera, settings) = frame(args, plan, &scene, camera)?;
+    // A scene lit only by its emissive surfaces gets the studio light too when the camera
+    // sees mostly background: a product model whose only emitters are small details.
+    let empty_share = (args.world.environment.is_none() && scene.lit_only_by_surfaces())
+        .then(|| empty_view_share(&scene, &camera, settings.width, settings.height));
+    let object_on_nothing = empty_share.is_some_and(|share| share > OBJECT_ON_NOTHING);
+    let environment = apply_environment(&mut scene, &args.world, object_on_nothing)?;
+    check_contents(args, plan, &scene, &environment, empty_share)?;
     Ok(Prepared {
         scene,
         camera,
@@ -118,6 +123,7 @@ fn check_contents(
     plan: &Plan,
     scene: &Scene,
     environment: &EnvironmentSetting,
+    empty_share: Option<f32>,
 ) -> Result<()> {
     let scene_path = plan.request.scene_path;
     let triangles = scene.instanced_triangle_count() as u64;
@@ -134,7 +140,7 @@ fn check_contents(
             scene_path.display()
         ));
     } else if environment.source == EnvironmentSource::Studio {
-        crate::terminal::say(format_args!("{}", studio_note(scene_path)));
+        crate::terminal::say(format_args!("{}", studio_note(scene_path, empty_share)));
     } else if !scene.has_emitters() {
         crate::terminal::say(format_args!(
             "warning: {}: the scene has no emitters (no emissive material, no light, no environment); the image will be black",

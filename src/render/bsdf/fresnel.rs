@@ -44,15 +44,17 @@ pub enum Fresnel {
         /// Reflectance at grazing incidence.
         f90: f32,
     },
-    /// A dielectric of relative index `eta` (exact Fresnel) scaled per channel: the glTF
-    /// specular layer and the clear coat. Cycles' Principled BSDF uses the exact Fresnel for
-    /// both; with glTF's Schlick approximation the highlights of Blender's plastics were
-    /// 3 % weaker than Cycles' (README, "Materials").
+    /// A dielectric of relative index `eta` (exact Fresnel F_η), remapped per channel to
+    /// offset + scale·F_η: the glTF specular layer and the clear coat. Cycles' Principled
+    /// BSDF uses the exact Fresnel for both; with glTF's Schlick approximation the
+    /// highlights of Blender's plastics were 3 % weaker than Cycles' (README, "Materials").
     Dielectric {
         /// η of the material over the outside (≥ 1).
         eta: f32,
-        /// Scale of the whole curve: F0 becomes scale·F0(η), grazing reflectance scale.
+        /// Scale of the curve.
         scale: Vec3,
+        /// Added to the scaled curve.
+        offset: Vec3,
     },
 }
 
@@ -61,7 +63,9 @@ impl Fresnel {
     pub fn eval(&self, cos: f32) -> Vec3 {
         match *self {
             Fresnel::Schlick { f0, f90 } => fresnel_schlick(f0, f90, cos),
-            Fresnel::Dielectric { eta, scale } => scale * fresnel_dielectric(cos, 1.0 / eta),
+            Fresnel::Dielectric { eta, scale, offset } => {
+                offset + scale * fresnel_dielectric(cos, 1.0 / eta)
+            }
         }
     }
 }

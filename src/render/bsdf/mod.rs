@@ -73,6 +73,9 @@ pub struct Bsdf {
     /// been raised for the glossy lobes ([`Bsdf::with_diffuse_normal`]): world space, and
     /// as a frame in the local frame of the glossy normal.
     diffuse_normal: Option<(Vec3, Frame)>,
+    /// The interpolated normal before normal mapping (glossy frame) and the α² of the
+    /// shadowing that softens the cosine lobes' terminator on normal-mapped surfaces.
+    bump: Option<(Vec3, f32)>,
 }
 
 /// A direction drawn from a BSDF.
@@ -119,17 +122,22 @@ impl Bsdf {
         let dielectric = (1.0 - metallic) * (1.0 - transmission);
         let base = pbr.base_colour.clamp(Vec3::ZERO, Vec3::ONE);
         let positive = |w: f32| (w > 0.0).then_some(w);
-        // KHR_materials_specular's F0 = min(F0(ior)·specularColour, 1)·specular, reached as
-        // Cycles reaches its "Specular IOR Level": on the exact Fresnel curve of the index
-        // whose F0 is the largest channel's, so that reflection still rises to 1 at grazing
-        // angles, the other channels scaled down.
-        let f0 = (f0_of_ior(pbr.ior) * pbr.specular_colour.max(Vec3::ZERO)).min(Vec3::ONE)
-            * pbr.specular.clamp(0.0, 1.0);
-        let peak = f0.max_element().min(0.99);
-        let specular = positive(dielectric).filter(|_| peak > 0.0).map(|w| {
+        // The specular layer as Cycles' Principled BSDF makes it (svm/closure.h): the
+        // specular weight (KHR_materials_specular's specular, Blender's Specular IOR Level)
+        // moves F0 = F0(ior)·specular along the exact Fresnel curve F_η of the index with
+        // that F0, and the specular colour (Specular Tint) remaps the curve to start at
+        // F0·colour and still rise to 1 at grazing angles:
+        // F = F0·colour + (1 − F0·colour)·(F_η − F0)/(1 − F0). A specular colour of 0 keeps
+        // that grazing rise; glTF's F0 = min(F0(ior)·colour, 1)·specular is the same at
+        // normal incidence.
+        let f0 = (f0_of_ior(pbr.ior) * pbr.specular.clamp(0.0, 1.0)).min(0.99);
+        let specular = positive(dielectric).filter(|_| f0 > 0.0).map(|w| {
+            let tinted = (f0 * pbr.specular_colour.max(Vec3::ZERO)).min(Vec3::ONE);
+            let scale = (Vec3::ONE - tinted) / (1.0 - f0);
             let fresnel = Fresnel::Dielectric {
-                eta: ior_of_f0(peak),
-                scale: (f0 / peak).min(Vec3::ONE),
+                eta: ior_of_f0(f0),
+                scale,
+                offset: tinted - scale * f0,
             };
             (SpecularLobe::new(roughness, fresnel), w)
         });
@@ -149,6 +157,7 @@ impl Bsdf {
             let fresnel = Fresnel::Dielectric {
                 eta: COAT_IOR,
                 scale: Vec3::splat(c),
+                offset: Vec3::ZERO,
             };
             SpecularLobe::new(pbr.clearcoat_roughness.clamp(0.0, 1.0), fresnel)
         });
@@ -167,6 +176,7 @@ impl Bsdf {
             coat_frame: None,
             sheen,
             diffuse_normal: None,
+            bump: None,
         }
     }
 
@@ -190,6 +200,39 @@ impl Bsdf {
             self.diffuse_normal = Some((diffuse_normal, Frame::from_normal(local)));
         }
         self
+    }
+
+    /// The same BSDF on a normal-mapped surface whose interpolated normal was `smooth`
+    /// (world space, `n` the glossy normal): its cosine lobes are shadowed by
+    /// G1(α², |smooth·wi|) with α² = min(tan²θd / 8, 1), θd between `smooth` and the
+    /// diffuse normal — Conty Estevez et al. 2019, "A Microfacet-Based Shadowing Function
+    /// to Solve the Bump Terminator Problem", as Cycles applies it (`bump_shadowing_term`)
+    /// with its material's Bump Map Correction (on by default).
+    pub fn with_bump_shadowing(mut self, n: Vec3, smooth: Vec3) -> Bsdf {
+        let diffuse = self.diffuse_normal.map_or(n, |(d, _)| d);
+        let cos_d = smooth.dot(diffuse).abs();
+        if cos_d < 1.0 && cos_d > 0.0 {
+            let tan2 = 1.0 / (cos_d * cos_d) - 1.0;
+            let alpha2 = (0.125 * tan2).clamp(0.0, 1.0);
+            self.bump = Some((Frame::from_normal(n).to_local(smooth), alpha2));
+        }
+        self
+    }
+
+    /// The bump shadowing of the cosine lobes towards local `wi`.
+    fn bump_shadowing(&self, wi: Vec3) -> f32 {
+        let Some((smooth, alpha2)) = self.bump else {
+            return 1.0;
+        };
+        let cos_i = smooth.dot(wi).abs();
+        if cos_i >= 1.0 {
+            return 1.0;
+        }
+        if cos_i < 1e-6 {
+            return 0.0;
+        }
+        let tan2 = 1.0 / (cos_i * cos_i) - 1.0;
+        2.0 / (1.0 + (1.0 + alpha2 * tan2).sqrt())
     }
 
     /// A direction of the glossy frame in the cosine lobes' frame.
@@ -259,6 +302,7 @@ impl Bsdf {
             && self.glass.is_none()
             && self.coat.is_none()
             && self.sheen.is_none()
+            && self.bump.is_none()
     }
 
     /// True when the cosine strategy (Lambertian base, sheen) has anything to draw.
@@ -299,7 +343,7 @@ impl Bsdf {
             f += coat.eval(coat_wo, self.in_coat_frame(wi)) * wi.z;
         }
         let (diffuse_wo, diffuse_wi) = (self.in_diffuse_frame(wo), self.in_diffuse_frame(wi));
-        let diffuse_cos = diffuse_wi.z.max(0.0);
+        let diffuse_cos = diffuse_wi.z.max(0.0) * self.bump_shadowing(wi);
         if let Some((colour, roughness)) = self.sheen {
             let factor = self
                 .coat

@@ -42,7 +42,9 @@ impl SpecularLobe {
         let multiple = if ggx.is_some() {
             let average = match fresnel {
                 Fresnel::Schlick { f0, f90 } => schlick_average(f0, f90),
-                Fresnel::Dielectric { eta, scale } => scale * glass_table().fresnel_average(eta),
+                Fresnel::Dielectric { eta, scale, offset } => {
+                    offset + scale * glass_table().fresnel_average(eta)
+                }
             };
             let e = tables().white_average(roughness);
             average * e / (Vec3::ONE - average * (1.0 - e)).max(Vec3::splat(1e-4))
@@ -78,8 +80,8 @@ impl SpecularLobe {
         let (scale, ab) = self.compensation(mu);
         let single = match self.fresnel {
             Fresnel::Schlick { f0, f90 } => f0 * ab.x + Vec3::splat(f90) * ab.y,
-            Fresnel::Dielectric { eta, scale } => {
-                scale * glass_table().reflection(mu, self.roughness, eta)
+            Fresnel::Dielectric { eta, scale, offset } => {
+                offset * (ab.x + ab.y) + scale * glass_table().reflection(mu, self.roughness, eta)
             }
         };
         single * scale
@@ -202,6 +204,7 @@ mod tests {
             Fresnel::Dielectric {
                 eta: 1.6,
                 scale: Vec3::new(1.0, 0.5, 2.0),
+                offset: Vec3::new(0.0, 0.2, 0.05),
             },
         );
         for (lobe, mu) in [

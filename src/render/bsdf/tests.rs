@@ -335,3 +335,23 @@ fn ideal_special_cases() {
     assert!(trans.is_transmission && trans.wi.z < 0.0);
     assert!((trans.weight.x - 1.0).abs() < 1e-5, "{}", trans.weight);
 }
+
+/// On a normal-mapped surface the cosine lobes fade out towards the smooth surface's
+/// horizon (bump shadowing), leave light along the smooth normal alone, and a surface
+/// without a normal map is untouched.
+#[test]
+fn bump_shadowing_softens_the_terminator_only_where_normals_were_mapped() {
+    let pbr = Pbr::diffuse(Vec3::splat(0.5));
+    let mapped = Vec3::new(45f32.to_radians().sin(), 0.0, 45f32.to_radians().cos());
+    let plain = Bsdf::new(&pbr, true);
+    let bumped = plain.with_bump_shadowing(mapped, Vec3::Z);
+    let wo = mapped;
+    let f = |bsdf: &Bsdf, wi: Vec3| bsdf.eval(mapped, wo, wi).x;
+    let along_smooth = Vec3::Z;
+    assert!((f(&bumped, along_smooth) - f(&plain, along_smooth)).abs() < 1e-6);
+    let grazing = Vec3::new(1.0, 0.0, 0.02).normalize();
+    let ratio = f(&bumped, grazing) / f(&plain, grazing);
+    assert!(ratio > 0.0 && ratio < 0.5, "{ratio}");
+    let unmapped = plain.with_bump_shadowing(Vec3::Z, Vec3::Z);
+    assert_eq!(unmapped, plain);
+}
