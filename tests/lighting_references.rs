@@ -104,3 +104,13 @@ fn depth_of_field_from_usd_matches_cycles() {
     assert!(scene.cameras[0].lens.is_some(), "the camera's lens");
     check("lighting_dof", "lighting_dof.usdc", &scene);
 }
+
+/// A room lit by a ceiling area lamp 5 cm under the ceiling and Blender's default point
+/// lamp (radius 0.1 m, Soft Falloff) low over the floor: the lamp is not geometry, so the
+/// ceiling above it is lit by the floor's light passing it, and the floor near the point
+/// lamp falls off as Cycles' disc does.
+#[test]
+fn ceiling_area_lamp_and_soft_falloff_lamp_from_usd_match_cycles() {
+    let scene = scene("lighting_room_lamps.usdc");
+    check("lighting_room_lamps", "lighting_room_lamps.usdc", &scene);
+}

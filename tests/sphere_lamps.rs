@@ -49,6 +49,7 @@ fn lamp(position: Vec3, spot: Option<(Vec3, f32, f32)>, camera_visible: bool) ->
         radiance: Vec3::new(20.0, 10.0, 5.0),
         spot,
         camera_visible,
+        soft: false,
     }
 }
 
@@ -76,6 +77,43 @@ fn a_floor_under_a_sphere_lamp_gets_its_cap_irradiance() {
             let result = estimate(&scene, ray, strategy, n);
             let want = expected(0.5, center, x).as_dvec3();
             assert_matches(&format!("at {x}, {strategy:?}"), result, want, 0.01);
+        }
+    }
+}
+
+/// Blender's Soft Falloff makes the lamp a disc of its radius facing the lit point: the
+/// disc subtends sin²θ = r²/(d² + r²), so the floor's radiance is ρ·L·r²/(d² + r²)·cos α,
+/// softer than the ball's ρ·L·(r/d)²·cos α close to the lamp; every strategy agrees.
+#[test]
+fn a_soft_falloff_lamp_lights_as_a_disc_facing_the_floor() {
+    let center = Vec3::new(0.0, 0.5, 0.0);
+    let soft = LightKind::Sphere {
+        position: center,
+        radius: 0.3,
+        radiance: Vec3::new(20.0, 10.0, 5.0),
+        spot: None,
+        camera_visible: false,
+        soft: true,
+    };
+    let scene = floor_under(soft, 0.5);
+    for x in [Vec3::ZERO, Vec3::new(0.6, 0.0, -0.3)] {
+        let to = center - x;
+        let d2 = to.length_squared();
+        let want = 0.5 * Vec3::new(20.0, 10.0, 5.0) * 0.09 / (d2 + 0.09) * (to.y / d2.sqrt());
+        let ray = Ray::new(x + Vec3::new(0.05, 3.0, 0.6), Vec3::new(-0.05, -3.0, -0.6));
+        for strategy in STRATEGIES {
+            let n = if strategy == Strategy::BsdfOnly {
+                1_000_000
+            } else {
+                40_000
+            };
+            let result = estimate(&scene, ray, strategy, n);
+            assert_matches(
+                &format!("soft, at {x}, {strategy:?}"),
+                result,
+                want.as_dvec3(),
+                0.01,
+            );
         }
     }
 }

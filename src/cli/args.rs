@@ -5,7 +5,9 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use super::choices::{FilterChoice, LightUnitsChoice, ProgressChoice, ViewChoice};
+use super::choices::{
+    FilterChoice, LightUnitsChoice, ProgressChoice, SoftFalloffChoice, ViewChoice,
+};
 use super::values::{
     EnvironmentChoice, parse_degrees, parse_distance, parse_environment, parse_exposure,
     parse_filter_width, parse_fps, parse_frame, parse_fstop, parse_motion_steps, parse_seconds,
@@ -235,6 +237,12 @@ pub struct LoadArgs {
     /// "Standard" export), or Blender's "Unitless" or "Raw" lighting modes.
     #[arg(long, value_enum, value_name = "UNITS", default_value = "standard")]
     pub gltf_light_units: LightUnitsChoice,
+
+    /// Blender's Soft Falloff for lamps with a radius in files Blender wrote (on by default
+    /// in Blender and not written by its exporters): `auto` renders them as Cycles does,
+    /// `off` as balls.
+    #[arg(long, value_enum, value_name = "auto|off", default_value = "auto")]
+    pub soft_falloff: SoftFalloffChoice,
 
     /// Another folder the scene may read files from (USD libraries shared between scenes),
     /// besides the scene file's own folder; repeatable. Nothing else is read.

@@ -30,6 +30,16 @@ impl From<LightUnitsChoice> for GltfLightUnits {
     }
 }
 
+/// `--soft-falloff`: whether Blender's Soft Falloff is followed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum SoftFalloffChoice {
+    /// As the file's writer means: on for files Blender wrote.
+    #[default]
+    Auto,
+    /// Lamps with a radius are balls.
+    Off,
+}
+
 /// Which pixel filter.
 /// `--progress`: how progress is reported for programs (the Blender add-on).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

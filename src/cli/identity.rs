@@ -68,6 +68,9 @@ fn load_label(options: &LoadOptions) -> String {
     if let Some(levels) = options.subdivision_level {
         label += &format!(" subdivision-level={levels}");
     }
+    if options.hard_falloff {
+        label += " soft-falloff=off";
+    }
     label
 }
 

@@ -165,6 +165,9 @@ fn material_summary(m: &Material, emitted: f32) -> String {
             significant(emitted)
         );
     }
+    if m.lamp {
+        s.push_str("; a lamp (casts no shadow, rays pass it)");
+    }
     if !m.double_sided {
         s.push_str("; one-sided");
     }
@@ -232,8 +235,9 @@ fn light_summary(kind: &LightKind) -> String {
             radiance,
             spot,
             camera_visible,
+            soft,
         } => format!(
-            "sphere at {}, radius {radius}, radiance {}, {} W{}{}",
+            "sphere at {}, radius {radius}, radiance {}, {} W{}{}{}",
             vector(position),
             vector(radiance),
             significant(kind.power(0.0)),
@@ -247,7 +251,8 @@ fn light_summary(kind: &LightKind) -> String {
                 ""
             } else {
                 ", hidden from the camera"
-            }
+            },
+            if soft { ", soft falloff" } else { "" }
         ),
         LightKind::Directional {
             direction,

@@ -60,6 +60,9 @@ pub struct LoadOptions {
     /// The stage has been probed at this frame already (by a probe given it in
     /// `probe_also_at`): read it without a child process.
     pub probed: bool,
+    /// Lamps with a radius shine as balls even where the file's writer (Blender) means
+    /// Soft Falloff, which makes them discs facing what they light (`--soft-falloff off`).
+    pub hard_falloff: bool,
 }
 
 /// Levels a subdivision surface is refined to by default: Blender's Subdivision modifier

@@ -153,9 +153,24 @@ impl Renderer<'_> {
             let s = surface_at(self.scene, &self.frames, &hit);
             let material = &self.scene.materials[s.material];
             let hidden = depth == 0 && !material.camera_visible;
+            if material.lamp && !hidden && s.geometric_normal.dot(ray.direction) < 0.0 {
+                // A lamp's shape: its light, weighed like any emitter's, and the ray goes on.
+                let cos_o = -s.geometric_normal.dot(ray.direction.normalize());
+                let light_pdf = self.lights.pdf(
+                    hit.instance,
+                    hit.triangle,
+                    hit.time,
+                    vertex,
+                    vertex_normal,
+                    travelled,
+                    cos_o,
+                );
+                let weight = emission_weight(arrival, strategy, light_pdf);
+                result.radiance += weight * beta * self.shade(&s, true).emission;
+            }
             if hidden || !self.is_present(&s, sampler) {
-                // A cutout, a blended surface the ray passes or a surface the camera does
-                // not see: go on in the same direction.
+                // A cutout, a blended surface the ray passes, a lamp or a surface the
+                // camera does not see: go on in the same direction.
                 pass_throughs += 1;
                 if pass_throughs > MAX_PASS_THROUGHS {
                     break;

@@ -136,7 +136,8 @@ pub struct Renderer<'a> {
     accel: SceneAccel,
     lights: LightSet,
     frames: Vec<InstanceFrame>,
-    /// True when some material has alpha cutouts or blending, so hits must be checked.
+    /// True when some material has alpha cutouts or blending, or is a lamp's shape, so
+    /// hits must be checked.
     has_cutouts: bool,
     /// False when camera rays that leave the scene must see black (alpha 0).
     environment_visible: bool,
@@ -158,7 +159,7 @@ impl<'a> Renderer<'a> {
             accel: SceneAccel::build_with(scene, top_level),
             lights: LightSet::build(scene),
             frames: InstanceFrame::for_scene(scene),
-            has_cutouts: scene.materials.iter().any(|m| m.is_cutout()),
+            has_cutouts: scene.materials.iter().any(|m| m.is_cutout() || m.lamp),
             environment_visible: scene.environment.as_ref().is_none_or(|e| e.camera_visible),
             bsdfs: scene
                 .materials

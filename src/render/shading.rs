@@ -104,9 +104,13 @@ impl Renderer<'_> {
     }
 
     /// True when the surface at `s` is really there for a ray: cutouts (alpha mask) are
-    /// holes, and a blended surface is there with probability alpha.
+    /// holes, a blended surface is there with probability alpha, and a lamp's shape is
+    /// never there (rays collect its light and pass).
     pub(super) fn is_present(&self, s: &Surface, sampler: &mut Sampler) -> bool {
         let material = &self.scene.materials[s.material];
+        if material.lamp {
+            return false;
+        }
         match material.alpha_mode {
             AlphaMode::Opaque => true,
             AlphaMode::Mask { cutoff } => self.alpha_at(material, s) >= cutoff,

@@ -50,6 +50,10 @@ pub enum LightKind {
         spot: Option<(Vec3, f32, f32)>,
         /// When false, camera rays pass it unseen (Blender's lamps, UsdLux lights).
         camera_visible: bool,
+        /// Blender's Soft Falloff (on by default): the lamp shines as a disc of its radius
+        /// turned towards the point it lights, as Cycles renders it, so light fades
+        /// smoothly close to it instead of rising like a ball's.
+        soft: bool,
     },
     /// Parallel light from infinitely far away, like the sun.
     Directional {

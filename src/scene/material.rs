@@ -209,6 +209,10 @@ pub struct Material {
     /// it scatters nothing and lights nothing else, and casts shadows like any opaque
     /// surface. Blender's glTF importer shows it to camera rays only.
     pub unlit: bool,
+    /// A lamp's shape (USD `RectLight`, `DiskLight`): it emits, and every ray passes
+    /// through it, so it scatters nothing and casts no shadow — Cycles' area lights are
+    /// lights, not geometry. Light sampling and rays that pass it still find its emission.
+    pub lamp: bool,
 }
 
 impl Material {
@@ -226,6 +230,7 @@ impl Material {
             absorption: Vec3::ZERO,
             camera_visible: true,
             unlit: false,
+            lamp: false,
         }
     }
 

@@ -20,9 +20,12 @@ unbiased settings, but keeps the world.
 - lighting_dof: lighting_sun_sky through a lens (f/0.4, focused on the grey sphere):
   Blender's camera depth of field as its USD exporter writes it. `.usdc` only.
 - lighting_lamps: a square area lamp, a point lamp of radius 0.25 m and a spot lamp of
-  radius 0.15 m (Soft Falloff off: true spheres), in view (Cycles does not show lamps to the
-  camera), black world. `.usdc` only: the glTF exporter drops area
-  lamps and point radii.
+  radius 0.15 m (Soft Falloff on, Blender's default), in view (Cycles does not show lamps to
+  the camera), black world. `.usdc` only: the glTF exporter drops area lamps and point radii.
+- lighting_room_lamps: a room lit by a ceiling area lamp 5 cm under the ceiling, facing
+  down, and Blender's default point lamp (radius 0.1 m, Soft Falloff) low over the floor:
+  the ceiling is lit by light from the floor that passes the lamp (Cycles' lamps are not
+  geometry), and the floor near the point lamp shows the soft falloff. `.usdc` only.
 """
 
 import math
@@ -143,10 +146,9 @@ def build_lamps(scene):
     point = bpy.data.lights.new("Point", "POINT")
     point.energy = 120.0
     point.shadow_soft_size = 0.25
-    # "Soft Falloff" (Blender's default) makes Cycles treat the lamp as a disc facing each
-    # shading point, not a sphere; USD has no word for it, and gridtrace renders the sphere
-    # the file describes. With it on, Cycles' far floor is about 4 % darker than the sphere's.
-    point.use_soft_falloff = False
+    # Soft Falloff stays on, as Blender sets it: Cycles then lights with a disc facing each
+    # shading point. USD has no word for it; gridtrace follows Blender's default for files
+    # Blender wrote.
     bulb = bpy.data.objects.new("Point", point)
     bulb.location = (1.4, -0.6, 1.7)
     scene.collection.objects.link(bulb)
@@ -155,7 +157,6 @@ def build_lamps(scene):
     spot = bpy.data.lights.new("Spot", "SPOT")
     spot.energy = 300.0
     spot.shadow_soft_size = 0.15
-    spot.use_soft_falloff = False
     spot.spot_size = math.radians(50.0)
     spot.spot_blend = 0.0
     cone = bpy.data.objects.new("Spot", spot)
@@ -164,6 +165,29 @@ def build_lamps(scene):
     direction = Vector((-3.5, -1.5, -3.0))
     cone.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
     scene.collection.objects.link(cone)
+
+
+def build_room_lamps(scene):
+    grey, warm = matte("Walls", (0.8, 0.8, 0.8)), matte("Back", (0.8, 0.6, 0.4))
+    quad("Floor", [(-2, -3, 0), (2, -3, 0), (2, 2, 0), (-2, 2, 0)], grey)
+    quad("Ceiling", [(-2, -3, 2.5), (-2, 2, 2.5), (2, 2, 2.5), (2, -3, 2.5)], grey)
+    quad("Back", [(-2, 2, 0), (2, 2, 0), (2, 2, 2.5), (-2, 2, 2.5)], warm)
+    quad("Left", [(-2, -3, 0), (-2, 2, 0), (-2, 2, 2.5), (-2, -3, 2.5)], grey)
+    quad("Right", [(2, -3, 0), (2, -3, 2.5), (2, 2, 2.5), (2, 2, 0)], grey)
+    area = bpy.data.lights.new("CeilingLamp", "AREA")
+    area.shape = "SQUARE"
+    area.size = 0.8
+    area.energy = 25.0
+    lamp = bpy.data.objects.new("CeilingLamp", area)
+    lamp.location = (0.0, 0.3, 2.45)
+    scene.collection.objects.link(lamp)
+    point = bpy.data.lights.new("Point", "POINT")
+    point.energy = 5.0
+    point.shadow_soft_size = 0.1
+    bulb = bpy.data.objects.new("Point", point)
+    bulb.location = (1.2, 1.0, 0.35)
+    scene.collection.objects.link(bulb)
+    add_camera(scene, (0.0, -2.8, 1.2), (0.0, 1.0, 1.4), 70.0)
 
 
 def build_dof(scene):
@@ -182,6 +206,7 @@ SCENE_TABLE = {
     "lighting_hdr": (build_hdr, 2048, ("glb", "usdc")),
     "lighting_sun_sky": (build_sun_sky, 2048, ("glb", "usdc")),
     "lighting_lamps": (build_lamps, 2048, ("usdc",)),
+    "lighting_room_lamps": (build_room_lamps, 2048, ("usdc",)),
     "lighting_dof": (build_dof, 2048, ("usdc",)),
 }
 

@@ -9,6 +9,7 @@ use std::time::Duration;
 use anyhow::{Result, anyhow, bail};
 
 use super::super::args::Args;
+use super::super::choices::SoftFalloffChoice;
 use super::super::signals::{arm_load_timeout, check_output};
 use crate::limits::set_memory_budget;
 use crate::load::LoadOptions;
@@ -61,6 +62,7 @@ pub fn read_request(args: &Args) -> Result<Request<'_>> {
         animation: loading.animation.clone(),
         asset_paths: loading.asset_path.clone(),
         subdivision_level: loading.subdivision_level,
+        hard_falloff: loading.soft_falloff == SoftFalloffChoice::Off,
         ..LoadOptions::default()
     };
     for dir in &loading.asset_path {

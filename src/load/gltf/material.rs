@@ -175,6 +175,7 @@ impl GltfLoader {
             alpha_mode,
             absorption,
             camera_visible: true,
+            lamp: false,
             unlit: material.extension_value("KHR_materials_unlit").is_some(),
         }
     }

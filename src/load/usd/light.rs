@@ -158,6 +158,7 @@ impl UsdLoader {
                 let material = loader.builder.add_material(Material {
                     double_sided: false,
                     camera_visible,
+                    lamp: true,
                     ..Material::diffuse(where_.clone(), Vec3::ZERO).with_emission(radiance)
                 });
                 let mesh = loader
@@ -225,6 +226,9 @@ impl UsdLoader {
                         radiance,
                         spot: cone,
                         camera_visible,
+                        // Blender turns Soft Falloff on for every new lamp and its USD
+                        // export does not say; other writers mean a ball.
+                        soft: self.soft_falloff && self.from_blender,
                     }
                 } else {
                     // A point: a sphere of radiance L sends L·πr² per steradian; normalized,

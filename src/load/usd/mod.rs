@@ -75,10 +75,10 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError
             probe::probe_stage(path, || {
                 times
                     .into_iter()
-                    .all(|t| read_stage(path, t, options.subdivision_levels(), &roots).is_ok())
+                    .all(|t| read_stage(path, t, options, &roots).is_ok())
             })?;
         }
-        read_stage(path, time, options.subdivision_levels(), &roots)
+        read_stage(path, time, options, &roots)
     })
     .unwrap_or_else(|why| {
         Err(LoadError::Invalid {
@@ -91,7 +91,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, LoadError
 fn read_stage(
     path: &Path,
     time: Option<f64>,
-    subdivision_levels: u32,
+    options: &LoadOptions,
     roots: &AssetRoots,
 ) -> Result<Loaded, LoadError> {
     let invalid = |what: String| LoadError::Invalid {
@@ -129,7 +129,8 @@ fn read_stage(
         roots: roots.clone(),
         stage,
         time,
-        subdivision_levels,
+        subdivision_levels: options.subdivision_levels(),
+        soft_falloff: !options.hard_falloff,
         builder: SceneBuilder::new(),
         materials: HashMap::new(),
         collections: HashMap::new(),
@@ -216,6 +217,9 @@ struct UsdLoader {
     time: usd::TimeCode,
     /// Levels subdivision surfaces are refined to.
     subdivision_levels: u32,
+    /// `LoadOptions::soft_falloff`: sphere lamps of a Blender file shine as Cycles'
+    /// Soft Falloff makes them.
+    soft_falloff: bool,
     builder: SceneBuilder,
     /// Our material index for each bound USD material prim path.
     materials: HashMap<String, usize>,

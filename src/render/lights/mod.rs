@@ -228,11 +228,13 @@ impl LightSet {
     ) {
         for &i in &self.spheres {
             let light = &self.punctual[i];
-            if let Some((radiance, t)) = punctual::met_along(light, origin, d, t_max, camera) {
+            if let Some((radiance, t)) =
+                punctual::met_along(light, vertex, origin, d, t_max, camera)
+            {
                 let pmf = self
                     .tree
                     .pmf(self.triangles.len() + i, vertex, vertex_normal);
-                found(radiance, pmf * punctual::sphere_pdf(light, vertex), t);
+                found(radiance, pmf * punctual::sphere_pdf(light, vertex, d), t);
             }
         }
     }
@@ -285,6 +287,7 @@ mod tests {
                 radiance: Vec3::splat(50.0),
                 spot: Some((down, 25f32.to_radians().cos(), 30f32.to_radians().cos())),
                 camera_visible: false,
+                soft: false,
             },
             LightKind::Point {
                 position: Vec3::new(5.0, 2.0, 0.0),

@@ -79,9 +79,14 @@ pub fn sample(light: &LightKind, pmf: f32, p: Vec3, far: f32, u: Vec2) -> Option
             position,
             radius,
             radiance,
+            soft,
             ..
         } => {
-            let s = sphere::sample(position, radius, p, u)?;
+            let s = if soft {
+                sphere::sample_disc(position, radius, p, u)?
+            } else {
+                sphere::sample(position, radius, p, u)?
+            };
             let spot = light.spot_factor(-s.wi);
             return Some(LightSample {
                 point: s.point,
@@ -124,9 +129,11 @@ pub fn sample(light: &LightKind, pmf: f32, p: Vec3, far: f32, u: Vec2) -> Option
 
 /// The radiance a ray from `origin` along unit direction `d` meets in sphere lamp `light`
 /// before `t_max`, and where: `None` for any other light, one the ray misses, or one a
-/// camera ray (`camera`) may not see.
+/// camera ray (`camera`) may not see. A soft-falloff lamp's disc faces `vertex`, where the
+/// path last scattered.
 pub fn met_along(
     light: &LightKind,
+    vertex: Vec3,
     origin: Vec3,
     d: Vec3,
     t_max: f32,
@@ -137,6 +144,7 @@ pub fn met_along(
         radius,
         radiance,
         camera_visible,
+        soft,
         ..
     } = *light
     else {
@@ -145,14 +153,24 @@ pub fn met_along(
     if camera && !camera_visible {
         return None;
     }
-    let t = sphere::intersect(position, radius, origin, d, 0.0, t_max)?;
+    let t = if soft {
+        sphere::intersect_disc(position, radius, vertex, origin, d, 0.0, t_max)?
+    } else {
+        sphere::intersect(position, radius, origin, d, 0.0, t_max)?
+    };
     Some((radiance * light.spot_factor(-d), t))
 }
 
 /// The solid-angle density with which [`sample`] at `vertex` draws a point of sphere lamp
-/// `light`, once chosen.
-pub fn sphere_pdf(light: &LightKind, vertex: Vec3) -> f32 {
+/// `light` in unit direction `d`, once chosen.
+pub fn sphere_pdf(light: &LightKind, vertex: Vec3, d: Vec3) -> f32 {
     match *light {
+        LightKind::Sphere {
+            position,
+            radius,
+            soft: true,
+            ..
+        } => sphere::pdf_disc(position, radius, vertex, d),
         LightKind::Sphere {
             position, radius, ..
         } => sphere::pdf(position, radius, vertex),

@@ -7,7 +7,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use crate::render::sampling::{Frame, uniform_cone};
+use crate::render::sampling::{Frame, concentric_disk, uniform_cone};
 
 /// A point drawn on a sphere as seen from a shading point.
 pub struct SpherePoint {
@@ -85,6 +85,62 @@ pub fn intersect(
     (t > t_min && t < t_max).then_some(t)
 }
 
+/// The disc of `radius` around `center` turned towards `p`: Cycles' point lamp with Soft
+/// Falloff (`kernel/light/point.h` without `is_sphere`). Its unit normal points at `p`.
+fn facing_disc(center: Vec3, p: Vec3) -> Option<Vec3> {
+    (p - center).try_normalize()
+}
+
+/// A point drawn uniformly over the disc of `radius` at `center` that faces `p`, with its
+/// solid-angle density t²/(πr²·cos θ).
+pub fn sample_disc(center: Vec3, radius: f32, p: Vec3, u: Vec2) -> Option<SpherePoint> {
+    let normal = facing_disc(center, p)?;
+    let offset = concentric_disk(u) * radius;
+    let point = center + Frame::from_normal(normal).to_world(offset.extend(0.0));
+    let to_point = point - p;
+    let distance = to_point.length();
+    let wi = to_point / distance;
+    let cos = normal.dot(-wi);
+    (distance > 0.0 && cos > 0.0).then(|| SpherePoint {
+        wi,
+        distance,
+        point,
+        normal,
+        pdf: distance * distance / (PI * radius * radius * cos),
+    })
+}
+
+/// The solid-angle density with which [`sample_disc`] from `p` draws unit direction `d`
+/// (zero when `d` misses the disc).
+pub fn pdf_disc(center: Vec3, radius: f32, p: Vec3, d: Vec3) -> f32 {
+    let Some(t) = intersect_disc(center, radius, p, p, d, 0.0, f32::INFINITY) else {
+        return 0.0;
+    };
+    let normal = facing_disc(center, p).unwrap_or(-d);
+    t * t / (PI * radius * radius * normal.dot(-d).max(1e-12))
+}
+
+/// Distance along unit direction `d` from `origin` to the disc of `radius` at `center`
+/// that faces `vertex` (where the path last scattered), between `t_min` and `t_max`.
+pub fn intersect_disc(
+    center: Vec3,
+    radius: f32,
+    vertex: Vec3,
+    origin: Vec3,
+    d: Vec3,
+    t_min: f32,
+    t_max: f32,
+) -> Option<f32> {
+    let normal = facing_disc(center, vertex)?;
+    let approach = d.dot(normal);
+    if approach >= 0.0 {
+        return None;
+    }
+    let t = (center - origin).dot(normal) / approach;
+    let inside = (origin + t * d).distance_squared(center) <= radius * radius;
+    (inside && t > t_min && t < t_max).then_some(t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,5 +164,28 @@ mod tests {
         }
         assert!(sample(center, radius, center + Vec3::X * 0.1, Vec2::splat(0.5)).is_none());
         assert!(intersect(center, radius, p, (p - center).normalize(), 0.0, 1e9).is_none());
+    }
+
+    /// Soft falloff's disc: samples face the point, rays find them again, the density is
+    /// what `pdf_disc` says, and it integrates to one over the directions to the disc.
+    #[test]
+    fn facing_disc_samples_are_found_again_with_their_density() {
+        let (center, radius, p) = (Vec3::new(1.0, 2.0, -3.0), 0.5, Vec3::new(0.2, -1.0, -2.0));
+        let mut r = Rng::new(5, 2);
+        let mut integral = 0.0f64;
+        let n = 200_000;
+        for _ in 0..n {
+            let s = sample_disc(center, radius, p, r.uniform2()).unwrap();
+            let t = intersect_disc(center, radius, p, p, s.wi, 0.0, f32::INFINITY).unwrap();
+            assert!((t - s.distance).abs() < 1e-3 * s.distance);
+            assert!((pdf_disc(center, radius, p, s.wi) / s.pdf - 1.0).abs() < 1e-3);
+            // Uniform directions over the cone around the disc: ∫pdf dω = 1.
+            let cone = one_minus_cos_max(center, radius, p).unwrap();
+            let axis = (center - p).normalize();
+            let d = Frame::from_normal(axis).to_world(uniform_cone(r.uniform2(), cone));
+            integral += f64::from(pdf_disc(center, radius, p, d) * 2.0 * PI * cone);
+        }
+        let mean = integral / n as f64;
+        assert!((mean - 1.0).abs() < 0.01, "{mean}");
     }
 }
