@@ -557,9 +557,11 @@ fn normal_mapped_floor(mut b: SceneBuilder, material: usize, mapped: Vec3) -> (S
 }
 
 /// A constant normal map tilts the shading normal by a known angle: under a directional
-/// light the floor's radiance is ρ/π · E · (n′·l) for the tilted n′. Tilting along the red
-/// channel turns the normal towards the tangent (+u); along green, towards the image's up
-/// (−v in glTF's downward-v texture space).
+/// light the floor's radiance is ρ/π · E · (n′·l) · G1 for the tilted n′, G1 being the
+/// bump-terminator shadowing of the mapped surface (Conty Estevez et al. 2019, as Cycles):
+/// 2/(1 + √(1 + α²·tan²θ)) with α² = tan²(tilt)/8 and θ between l and the smooth normal.
+/// Tilting along the red channel turns the normal towards the tangent (+u); along green,
+/// towards the image's up (−v in glTF's downward-v texture space).
 #[test]
 fn a_constant_normal_map_tilts_the_shading_normal() {
     let albedo = 0.5f32;
@@ -594,14 +596,18 @@ fn a_constant_normal_map_tilts_the_shading_normal() {
         // The world normal: T = +X, B = w·N×T = −Z, N = +Y.
         let n = (mapped.x * Vec3::X + mapped.y * Vec3::NEG_Z + mapped.z * Vec3::Y).normalize();
         let l = -travel.normalize();
-        let expected = (irradiance * albedo / std::f32::consts::PI * n.dot(l)).as_dvec3();
+        let alpha2 = tilt.tan().powi(2) / 8.0;
+        let tan2 = 1.0 / l.y.powi(2) - 1.0;
+        let shadowing = 2.0 / (1.0 + (1.0 + alpha2 * tan2).sqrt());
+        let expected =
+            (irradiance * albedo / std::f32::consts::PI * n.dot(l) * shadowing).as_dvec3();
         let target = v(0.2, 0.0, 0.1);
         let ray = Ray::new(target + v(0.3, 2.0, 0.4), v(-0.3, -2.0, -0.4));
         let (mean, _) = estimate(&scene, ray, Strategy::Mis, 16);
         assert!(
             (mean / expected - 1.0).abs().max_element() < 1e-3,
             "tilt {mapped}: {mean} vs {expected} (unmapped would be {})",
-            expected * (Vec3::Y.dot(l) / n.dot(l)) as f64
+            expected * (Vec3::Y.dot(l) / (n.dot(l) * shadowing)) as f64
         );
     }
 }

@@ -773,3 +773,26 @@ fn preview_surface_inputs_map_to_the_material_description() {
     assert_eq!((roughness.channel, metallic.channel), (1, 2));
     assert!((textured.pbr.roughness - 0.5).abs() < 1e-6 && textured.pbr.metallic == 1.0);
 }
+
+/// A UsdPreviewSurface whose diffuseColor reads `displayColor` through a
+/// `UsdPrimvarReader_float3` (written by Pixar's USD library, tools/dev/make_third_party.py)
+/// takes the mesh's own per-vertex colours: red corners stay red, blue ones blue.
+#[test]
+fn diffuse_colour_read_from_display_colour_takes_the_vertex_colours() {
+    let path = Path::new("tests/data/scenes/third_party/usd_core_primvar_colour.usda");
+    let loaded = load_scene(path).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let scene = loaded.scene;
+    let mesh = &scene.meshes[0];
+    let material = &scene.materials[mesh.material];
+    assert!(material.vertex_colours && material.pbr.base_colour == Vec3::ONE);
+    assert_eq!(mesh.colours.len(), mesh.positions.len());
+    for (p, c) in mesh.positions.iter().zip(&mesh.colours) {
+        let want = if p.x < 0.0 {
+            Vec3::new(0.8, 0.05, 0.05)
+        } else {
+            Vec3::new(0.05, 0.05, 0.8)
+        };
+        assert!(close(c.truncate(), want), "at {p}: {c}");
+    }
+}

@@ -9,6 +9,8 @@ camera. Run with a Python that has `trimesh`, `pygltflib` and `usd-core` (PyPI):
   accessor by accessor with pygltflib, as a flat object such as a watch would be.
 - `usd_core_disc.usda`: Pixar's USD library, a thin Z-up cylinder (a coin) with a
   UsdPreviewSurface bound.
+- `usd_core_primvar_colour.usda`: a plate whose diffuseColor reads displayColor through a
+  UsdPrimvarReader_float3 (red corners on the left, blue on the right).
 """
 
 import base64
@@ -125,9 +127,41 @@ def usd_core_disc(out: Path) -> None:
     stage.GetRootLayer().Save()
 
 
+def usd_core_primvar_colour(out: Path) -> None:
+    """A plate whose UsdPreviewSurface takes its diffuseColor from the mesh's displayColor
+    through a UsdPrimvarReader_float3, as the USD working group's assets do: red on the
+    left corners, blue on the right."""
+    from pxr import Sdf, Usd, UsdGeom, UsdShade
+
+    stage = Usd.Stage.CreateNew(str(out / "usd_core_primvar_colour.usda"))
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+    root = UsdGeom.Xform.Define(stage, "/Plate")
+    stage.SetDefaultPrim(root.GetPrim())
+    mesh = UsdGeom.Mesh.Define(stage, "/Plate/Mesh")
+    mesh.CreatePointsAttr([(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)])
+    mesh.CreateFaceVertexCountsAttr([4])
+    mesh.CreateFaceVertexIndicesAttr([0, 3, 2, 1])
+    colours = mesh.CreateDisplayColorPrimvar(UsdGeom.Tokens.vertex)
+    colours.Set([(0.8, 0.05, 0.05), (0.05, 0.05, 0.8), (0.05, 0.05, 0.8), (0.8, 0.05, 0.05)])
+    material = UsdShade.Material.Define(stage, "/Plate/Painted")
+    shader = UsdShade.Shader.Define(stage, "/Plate/Painted/Surface")
+    shader.CreateIdAttr("UsdPreviewSurface")
+    reader = UsdShade.Shader.Define(stage, "/Plate/Painted/DisplayColor")
+    reader.CreateIdAttr("UsdPrimvarReader_float3")
+    reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("displayColor")
+    reader.CreateOutput("result", Sdf.ValueTypeNames.Float3)
+    shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(
+        reader.ConnectableAPI(), "result")
+    shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(0.8)
+    material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+    UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(material)
+    stage.GetRootLayer().Save()
+
+
 if __name__ == "__main__":
     out = Path(sys.argv[1])
     out.mkdir(parents=True, exist_ok=True)
     trimesh_shapes(out)
     pygltflib_plate(out)
     usd_core_disc(out)
+    usd_core_primvar_colour(out)

@@ -79,15 +79,20 @@ impl UsdLoader {
             normal_scale: 1.0,
             ..MaterialTextures::default()
         };
-        // A connected input is a texture (its scale as the factor); else a constant.
-        let diffuse =
+        // A connected input is a texture (its scale as the factor), or the mesh's
+        // displayColor through a primvar reader; else a constant.
+        let reads_display_colour = self.reads_display_colour(&shader, "inputs:diffuseColor");
+        let diffuse = if reads_display_colour {
+            Vec3::ONE
+        } else {
             match self.texture_input(&shader, "inputs:diffuseColor", ColorSpace::Srgb, &name) {
                 Some((r, scale)) => {
                     textures.base_colour = Some(r);
                     scale
                 }
                 None => self.constant_colour(&shader, "inputs:diffuseColor", Vec3::splat(0.18)),
-            };
+            }
+        };
         let emission =
             match self.texture_input(&shader, "inputs:emissiveColor", ColorSpace::Srgb, &name) {
                 Some((r, scale)) => {
@@ -170,8 +175,28 @@ impl UsdLoader {
             emission,
             textures,
             alpha_mode,
+            vertex_colours: reads_display_colour,
             ..Material::new(name, pbr)
         }
+    }
+
+    /// True when `input` is connected to a `UsdPrimvarReader_float3` of `displayColor`:
+    /// the colour is then the mesh's own per-vertex or per-face display colour (what the
+    /// USD working group's assets and many converters write).
+    fn reads_display_colour(&self, shader: &sdf::Path, input: &str) -> bool {
+        let Some(node) = self.connected_prim(shader, input) else {
+            return false;
+        };
+        let id = self.get_token(&node, "info:id");
+        let varname = match self.input_value(&node, "inputs:varname") {
+            Some(sdf::Value::Token(t)) => Some(t.as_str().to_string()),
+            Some(sdf::Value::String(s)) => Some(s),
+            _ => None,
+        };
+        id.as_deref() == Some("UsdPrimvarReader_float3")
+            && varname
+                .as_deref()
+                .is_some_and(|v| v == "displayColor" || v == "primvars:displayColor")
     }
 
     /// A scalar input: its constant (or `default`), or a texture channel with the texture's

@@ -373,7 +373,10 @@ impl UsdLoader {
             };
             let mut normals_ok = normals.is_some();
             let mut st = Vec::new();
-            let colours = material == display
+            // The display material, or a bound one whose colour reads displayColor.
+            let reads_colours =
+                material == display || self.builder.material_mut(material).vertex_colours;
+            let colours = reads_colours
                 && (polygons.display_colour.is_some() || polygons.display_opacity.is_some());
             for (t, tri) in triangles.iter().enumerate() {
                 for &corner in tri {
