@@ -270,3 +270,41 @@ fn vertex_colours_and_a_second_uv_set_are_read() {
     assert_eq!(mesh.uvs.len(), 2);
     assert_eq!(mesh.uvs[1], mesh.uvs[0]);
 }
+
+/// `KHR_materials_specular`'s and `KHR_materials_sheen`'s textures are read: the strength
+/// textures from the alpha channel, the colour textures as sRGB colours, each multiplying
+/// its factor, with no warning.
+#[test]
+fn specular_and_sheen_textures_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    write_uvs(dir.path());
+    std::fs::write(dir.path().join("t.png"), png()).unwrap();
+    let mut doc = textured_document(
+        json!([{"uri": "t.png"}]),
+        json!([{
+            "name": "velvet",
+            "pbrMetallicRoughness": {"metallicFactor": 0.0},
+            "extensions": {
+                "KHR_materials_specular": {"specularFactor": 0.5, "specularTexture": {"index": 0},
+                    "specularColorFactor": [1.0, 0.5, 0.5], "specularColorTexture": {"index": 1}},
+                "KHR_materials_sheen": {"sheenColorFactor": [1.0, 1.0, 1.0], "sheenColorTexture": {"index": 0},
+                    "sheenRoughnessFactor": 0.5, "sheenRoughnessTexture": {"index": 1}}
+            }
+        }]),
+    );
+    doc["extensionsUsed"] = json!(["KHR_materials_specular", "KHR_materials_sheen"]);
+    let loaded = load_scene(&write_gltf(dir.path(), "t.gltf", &doc)).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let t = &loaded.scene.materials[0].textures;
+    assert_eq!(t.specular.map(|c| c.channel), Some(3));
+    assert_eq!(t.sheen_roughness.map(|c| c.channel), Some(3));
+    assert_eq!(
+        t.specular.unwrap().texture.texture,
+        t.sheen_colour.unwrap().texture
+    );
+    assert!(t.specular_colour.is_some());
+    assert_eq!(
+        t.specular_colour.unwrap().texture,
+        t.sheen_roughness.unwrap().texture.texture
+    );
+}

@@ -42,7 +42,7 @@ def build(binary, scene_file, output, settings):
     noise_threshold, time_limit, denoise, dof (None or (fstop, focus distance)),
     shutter (None or (open, close)), motion_steps, transparent, view_transform,
     exposure (None: Blender applies it to the linear result), aovs (list), checkpoint,
-    progress."""
+    progress, soft_falloff (False: every lamp with a radius has Blender's Soft Falloff off)."""
     s = settings
     args = [binary, scene_file, "-o", output, "--width", str(s["width"]), "--height", str(s["height"])]
     args += ["--frame", _number(s["frame"])]
@@ -83,6 +83,8 @@ def build(binary, scene_file, output, settings):
         args += ["--checkpoint", _number(s["checkpoint"])]
     if s.get("progress"):
         args += ["--progress", "json"]
+    if s.get("soft_falloff") is False:
+        args += ["--soft-falloff", "off"]
     return args
 
 

@@ -89,7 +89,16 @@ def read_settings(scene, view_layer, keys):
         "aovs": passes.aov_layers(keys),
         "checkpoint": g.update_seconds,
         "progress": True,
+        "soft_falloff": soft_falloff(scene),
     }
+
+
+def soft_falloff(scene):
+    """False when the scene's point and spot lamps with a radius all have Soft Falloff
+    turned off: the USD export does not say, and gridtrace assumes Blender's default (on)."""
+    lamps = [o.data for o in scene.objects
+             if o.type == "LIGHT" and o.data.type in {"POINT", "SPOT"} and o.data.shadow_soft_size > 0]
+    return not lamps or any(lamp.use_soft_falloff for lamp in lamps)
 
 
 def export(scene, folder, shutter):

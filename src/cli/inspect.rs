@@ -180,6 +180,10 @@ fn material_summary(m: &Material, emitted: f32) -> String {
         (t.transmission.is_some(), "transmission"),
         (t.clearcoat.is_some(), "coat"),
         (t.clearcoat_roughness.is_some(), "coat roughness"),
+        (t.specular.is_some(), "specular"),
+        (t.specular_colour.is_some(), "specular colour"),
+        (t.sheen_colour.is_some(), "sheen colour"),
+        (t.sheen_roughness.is_some(), "sheen roughness"),
         (t.normal.is_some(), "normal map"),
     ]
     .into_iter()

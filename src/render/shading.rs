@@ -82,6 +82,14 @@ impl Renderer<'_> {
         pbr.transmission *= channel(&textures.transmission);
         pbr.clearcoat *= channel(&textures.clearcoat);
         pbr.clearcoat_roughness *= channel(&textures.clearcoat_roughness);
+        pbr.specular *= channel(&textures.specular);
+        pbr.sheen_roughness *= channel(&textures.sheen_roughness);
+        if let Some(r) = &textures.specular_colour {
+            pbr.specular_colour *= lookup(r, ColorSpace::Srgb).truncate();
+        }
+        if let Some(r) = &textures.sheen_colour {
+            pbr.sheen_colour *= lookup(r, ColorSpace::Srgb).truncate();
+        }
         let mut emission = material.emission;
         if let Some(r) = &textures.emissive {
             emission *= lookup(r, ColorSpace::Srgb).truncate();

@@ -153,6 +153,14 @@ pub struct MaterialTextures {
     pub clearcoat: Option<ChannelRef>,
     /// Linear, multiplies [`Pbr::clearcoat_roughness`].
     pub clearcoat_roughness: Option<ChannelRef>,
+    /// Linear, multiplies [`Pbr::specular`] (`KHR_materials_specular`'s alpha channel).
+    pub specular: Option<ChannelRef>,
+    /// sRGB colour multiplying [`Pbr::specular_colour`].
+    pub specular_colour: Option<TextureRef>,
+    /// sRGB colour multiplying [`Pbr::sheen_colour`].
+    pub sheen_colour: Option<TextureRef>,
+    /// Linear, multiplies [`Pbr::sheen_roughness`] (`KHR_materials_sheen`'s alpha channel).
+    pub sheen_roughness: Option<ChannelRef>,
     /// Tangent-space normal map (linear, +Y up, OpenGL convention as glTF defines).
     pub normal: Option<TextureRef>,
     /// Scales the normal map's X and Y.
@@ -173,6 +181,10 @@ impl MaterialTextures {
             || self.transmission.is_some()
             || self.clearcoat.is_some()
             || self.clearcoat_roughness.is_some()
+            || self.specular.is_some()
+            || self.specular_colour.is_some()
+            || self.sheen_colour.is_some()
+            || self.sheen_roughness.is_some()
             || self.normal.is_some()
             || self.clearcoat_normal.is_some()
     }

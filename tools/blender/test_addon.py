@@ -247,19 +247,26 @@ def test_settings():
     world = bpy.data.worlds.new("Sky")
     world.color = (0.25, 0.5, 0.75)
     scene.world = world
+    # A point lamp with its Soft Falloff off, which the USD export cannot say.
+    bulb = bpy.data.lights.new("Bulb", "POINT")
+    bulb.shadow_soft_size = 0.1
+    bulb.use_soft_falloff = False
+    bulb_object = bpy.data.objects.new("Bulb", bulb)
+    bulb_object.location = (0.0, 0.0, 1.5)
+    scene.collection.objects.link(bulb_object)
     keep = os.path.join(WORK, "keep-settings")
     image, last = f12(scene, "settings.exr", keep)
     argv = last["command"]
     text = " ".join(argv)
     for expected in ("--width 32 --height 32", "--camera /root/Side_Cam/Side_Lens", "--fstop 2.8",
                      "--focus-distance 3.25", "--shutter=-0.25..0.25", "--hide-environment",
-                     "--view-transform standard"):
+                     "--view-transform standard", "--soft-falloff off"):
         check(expected in text, f"'{expected}' not in {text}")
     domes = glob.glob(os.path.join(keep, "textures", "color_*.exr"))
     check(len(domes) == 1, f"world colour textures: {domes}")
     check(image is not None and image["ViewLayer.Combined.A"].min() < 1, "film transparency left no alpha")
-    print("ok: resolution %, camera, depth of field, motion blur, world, view transform and transparency "
-          "reach gridtrace")
+    print("ok: resolution %, camera, depth of field, motion blur, world, view transform, transparency "
+          "and Soft Falloff reach gridtrace")
 
 
 def test_farm():

@@ -87,11 +87,14 @@ impl GltfLoader {
         if let Some(specular) = material.extension_value("KHR_materials_specular") {
             pbr.specular = json_f32(&specular["specularFactor"], 1.0).max(0.0);
             pbr.specular_colour = json_vec3(&specular["specularColorFactor"], Vec3::ONE);
-            self.warn_unread_textures(
-                &name,
-                specular,
-                &["specularTexture", "specularColorTexture"],
-            );
+            textures.specular = self
+                .json_texture(document, &specular["specularTexture"], &name)
+                .map(|texture| ChannelRef {
+                    texture,
+                    channel: 3,
+                });
+            textures.specular_colour =
+                self.json_texture(document, &specular["specularColorTexture"], &name);
         }
         if let Some(coat) = material.extension_value("KHR_materials_clearcoat") {
             pbr.clearcoat = json_f32(&coat["clearcoatFactor"], 0.0);
@@ -116,11 +119,13 @@ impl GltfLoader {
         if let Some(sheen) = material.extension_value("KHR_materials_sheen") {
             pbr.sheen_colour = json_vec3(&sheen["sheenColorFactor"], Vec3::ZERO);
             pbr.sheen_roughness = json_f32(&sheen["sheenRoughnessFactor"], 0.0);
-            self.warn_unread_textures(
-                &name,
-                sheen,
-                &["sheenColorTexture", "sheenRoughnessTexture"],
-            );
+            textures.sheen_colour = self.json_texture(document, &sheen["sheenColorTexture"], &name);
+            textures.sheen_roughness = self
+                .json_texture(document, &sheen["sheenRoughnessTexture"], &name)
+                .map(|texture| ChannelRef {
+                    texture,
+                    channel: 3,
+                });
         }
         if let Some(sg) = material.extension_value(spec_gloss::EXTENSION) {
             // It replaces pbrMetallicRoughness (the extension's specification).
@@ -262,22 +267,6 @@ impl GltfLoader {
             channel,
         };
         (textures.metallic, textures.roughness) = (Some(channel(2)), Some(channel(1)));
-    }
-
-    /// Extension textures gridtrace does not read yet get one warning each.
-    fn warn_unread_textures(
-        &mut self,
-        material: &str,
-        extension: &gltf::json::Value,
-        keys: &[&str],
-    ) {
-        for key in keys {
-            if extension.get(key).is_some() {
-                self.warn(format!(
-                    "material '{material}': {key} is not read; its factor is used alone"
-                ));
-            }
-        }
     }
 
     /// A material's use of a texture: its image (decoded once), sampler, coordinate set and
