@@ -12,9 +12,8 @@ use super::aov::Features;
 use super::bsdf::Bsdf;
 use super::sampler::Sampler;
 use super::sampling::power_heuristic;
-use super::shading::valid_reflection_normal;
 use super::surface::{Surface, surface_at};
-use crate::accel::Ray;
+use crate::accel::{Ray, SceneHit};
 use crate::geometry::offset_ray_origin;
 
 /// How direct light is estimated. Only [`Strategy::Mis`] is meant for images; the other two
@@ -156,16 +155,8 @@ impl Renderer<'_> {
             if material.lamp && !hidden && s.geometric_normal.dot(ray.direction) < 0.0 {
                 // A lamp's shape: its light, weighed like any emitter's, and the ray goes on.
                 let cos_o = -s.geometric_normal.dot(ray.direction.normalize());
-                let light_pdf = self.lights.pdf(
-                    hit.instance,
-                    hit.triangle,
-                    hit.time,
-                    vertex,
-                    vertex_normal,
-                    travelled,
-                    cos_o,
-                );
-                let weight = emission_weight(arrival, strategy, light_pdf);
+                let from = (vertex, vertex_normal, travelled);
+                let weight = self.emission_weight_at(&hit, from, cos_o, arrival, strategy);
                 result.radiance += weight * beta * self.shade(&s, true).emission;
             }
             if hidden || !self.is_present(&s, sampler) {
@@ -215,16 +206,8 @@ impl Renderer<'_> {
 
             // Emission reached by the previous bounce.
             if material.is_emissive() && (front || material.double_sided) {
-                let light_pdf = self.lights.pdf(
-                    hit.instance,
-                    hit.triangle,
-                    hit.time,
-                    vertex,
-                    vertex_normal,
-                    travelled,
-                    cos_o,
-                );
-                let weight = emission_weight(arrival, strategy, light_pdf);
+                let from = (vertex, vertex_normal, travelled);
+                let weight = self.emission_weight_at(&hit, from, cos_o, arrival, strategy);
                 result.radiance += weight * beta * shading.emission;
             }
             // A one-sided surface's back is black, but for glass it is the inside of the
@@ -240,28 +223,7 @@ impl Renderer<'_> {
             } else {
                 -s.geometric_normal
             };
-            let side = if shading.normal.dot(ng) < 0.0 {
-                -1.0
-            } else {
-                1.0
-            };
-            // Glossy lobes turn about a normal raised until mirror reflection stays above
-            // the surface (as Cycles does); the diffuse base and sheen keep the shading
-            // normal.
-            let ns_diffuse = side * shading.normal;
-            let ns = valid_reflection_normal(ng, wo, ns_diffuse);
-            let mut bsdf = match shading.coat_normal {
-                Some(coat) => shading
-                    .bsdf
-                    .with_coat_normal(ns, valid_reflection_normal(ng, wo, side * coat)),
-                None => shading.bsdf,
-            };
-            if ns != ns_diffuse {
-                bsdf = bsdf.with_diffuse_normal(ns, ns_diffuse);
-            }
-            if shading.normal != s.shading_normal {
-                bsdf = bsdf.with_bump_shadowing(ns, s.shading_normal);
-            }
+            let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo);
 
             // Sample a light for the next-event estimate. Punctual lights can only be found
             // this way, so even the BSDF-only estimator samples them.
@@ -400,6 +362,32 @@ impl Renderer<'_> {
             ray.t_min = hit.t;
         }
         true
+    }
+}
+
+impl Renderer<'_> {
+    /// The weight of the emission of the surface `hit` found by a ray that arrived as
+    /// `arrival` from `from` (the last scattering vertex, its normal and the distance
+    /// travelled since), leaving the surface at cosine `cos_o`.
+    fn emission_weight_at(
+        &self,
+        hit: &SceneHit,
+        from: (Vec3, Vec3, f32),
+        cos_o: f32,
+        arrival: Arrival,
+        strategy: Strategy,
+    ) -> f32 {
+        let (vertex, vertex_normal, travelled) = from;
+        let light_pdf = self.lights.pdf(
+            hit.instance,
+            hit.triangle,
+            hit.time,
+            vertex,
+            vertex_normal,
+            travelled,
+            cos_o,
+        );
+        emission_weight(arrival, strategy, light_pdf)
     }
 }
 

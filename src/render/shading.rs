@@ -27,6 +27,33 @@ pub struct Shading {
     pub coat_normal: Option<Vec3>,
 }
 
+impl Shading {
+    /// The BSDF turned to the side of `ng` (the geometric normal on the side `wo` lies
+    /// on), and the normal its glossy lobes turn about: the shading normal raised until
+    /// mirror reflection stays above the surface, as Cycles does
+    /// ([`valid_reflection_normal`]), while the diffuse base and sheen keep the shading
+    /// normal and, where a normal map bent it away from the interpolated `smooth` normal,
+    /// take the bump shadowing.
+    pub fn oriented(&self, smooth: Vec3, ng: Vec3, wo: Vec3) -> (Bsdf, Vec3) {
+        let side = if self.normal.dot(ng) < 0.0 { -1.0 } else { 1.0 };
+        let diffuse = side * self.normal;
+        let n = valid_reflection_normal(ng, wo, diffuse);
+        let mut bsdf = match self.coat_normal {
+            Some(coat) => self
+                .bsdf
+                .with_coat_normal(n, valid_reflection_normal(ng, wo, side * coat)),
+            None => self.bsdf,
+        };
+        if n != diffuse {
+            bsdf = bsdf.with_diffuse_normal(n, diffuse);
+        }
+        if self.normal != smooth {
+            bsdf = bsdf.with_bump_shadowing(n, smooth);
+        }
+        (bsdf, n)
+    }
+}
+
 /// Texture coordinates of set `set` at the surface point; zero if the mesh has none.
 pub fn uv_at(mesh: &Mesh, set: usize, vertices: [usize; 3], barycentrics: Vec3) -> Vec2 {
     barycentrics.x * mesh.uv(set, vertices[0])
