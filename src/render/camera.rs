@@ -57,6 +57,34 @@ impl RayGenerator {
         self.generate_through_lens(x, y, Vec2::splat(0.5), 0.0)
     }
 
+    /// World space to camera space at shutter time 0, the frame [`RayGenerator::generate`]
+    /// uses.
+    pub fn camera_from_world(&self) -> Affine3A {
+        self.motion
+            .as_ref()
+            .map_or(self.world_from_camera, |m| m.at(0.0))
+            .inverse()
+    }
+
+    /// Distance in front of the camera (camera-space −z) below which nothing is seen.
+    pub fn near(&self) -> f32 {
+        self.znear
+    }
+
+    /// Where pinhole rays meet camera-space point `p` (in front of the near plane): its
+    /// position in the image, in pixels from the top-left corner, as `generate` takes it.
+    pub fn image_position(&self, p: Vec3) -> Vec2 {
+        let plane = match self.projection {
+            Projection::Perspective { .. } => p.truncate() / -p.z,
+            Projection::Orthographic { .. } => p.truncate(),
+        };
+        let ndc = plane / self.half_extent;
+        Vec2::new(
+            (ndc.x + 1.0) * 0.5 * self.width as f32,
+            (1.0 - ndc.y) * 0.5 * self.height as f32,
+        )
+    }
+
     /// True when rays leave a lens of some size: each sample then needs a lens position.
     pub fn has_lens(&self) -> bool {
         self.lens.is_some()
