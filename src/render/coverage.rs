@@ -14,17 +14,37 @@ use crate::scene::{Camera, Scene};
 /// Rays per side of the grid of pixel-centred camera rays the share is measured with.
 const GRID: usize = 32;
 
-/// The share of a `GRID`×`GRID` grid of pinhole camera rays, over a `width`×`height`
-/// image at shutter open, that hit no geometry (alpha ignored).
-pub fn empty_view_share(scene: &Scene, camera: &Camera, width: u32, height: u32) -> f32 {
+/// What a `GRID`×`GRID` grid of pinhole camera rays over the image meets, as shares of
+/// the rays (alpha and occlusion ignored).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewCoverage {
+    /// Rays that meet no geometry.
+    pub empty: f32,
+    /// Rays that meet an emissive triangle and no other.
+    pub emitters: f32,
+    /// Rays that meet a surface that does not emit.
+    pub surfaces: f32,
+}
+
+/// Marks of a grid cell: an emissive triangle covers it, a non-emissive one does.
+const EMITTER: u8 = 1;
+const SURFACE: u8 = 2;
+
+/// What pinhole camera rays over a `width`×`height` image at shutter open meet.
+pub fn view_coverage(scene: &Scene, camera: &Camera, width: u32, height: u32) -> ViewCoverage {
     // A GRID×GRID image of the same aspect ratio: its pixel centres are the rays.
     let generator = RayGenerator::new(camera, width, height);
     let scale = Vec2::new(GRID as f32 / width as f32, GRID as f32 / height as f32);
     let camera_from_world = generator.camera_from_world();
     let near = generator.near().max(1e-6);
-    let mut covered = vec![false; GRID * GRID];
+    let mut covered = vec![0u8; GRID * GRID];
     for instance in &scene.instances {
         let mesh = &scene.meshes[instance.mesh];
+        let mark = if scene.materials[mesh.material].is_emissive() {
+            EMITTER
+        } else {
+            SURFACE
+        };
         let to_camera = camera_from_world * instance.world_from_object;
         for triangle in &mesh.indices {
             let corners = triangle.map(|i| to_camera.transform_point3(mesh.positions[i as usize]));
@@ -34,11 +54,18 @@ pub fn empty_view_share(scene: &Scene, camera: &Camera, width: u32, height: u32)
                 .map(|&p| generator.image_position(p) * scale)
                 .collect();
             for k in 1..image.len().saturating_sub(1) {
-                cover([image[0], image[k], image[k + 1]], &mut covered);
+                cover([image[0], image[k], image[k + 1]], mark, &mut covered);
             }
         }
     }
-    covered.iter().filter(|&&c| !c).count() as f32 / (GRID * GRID) as f32
+    let share = |f: &dyn Fn(u8) -> bool| {
+        covered.iter().filter(|&&c| f(c)).count() as f32 / (GRID * GRID) as f32
+    };
+    ViewCoverage {
+        empty: share(&|c| c == 0),
+        emitters: share(&|c| c == EMITTER),
+        surfaces: share(&|c| c & SURFACE != 0),
+    }
 }
 
 /// The part of a camera-space triangle in front of the near plane (z < −near), as a
@@ -61,7 +88,7 @@ fn in_front(corners: [Vec3; 3], near: f32) -> Vec<Vec3> {
 
 /// Marks the grid cells whose centres the image-space triangle covers (edges included,
 /// either winding).
-fn cover(t: [Vec2; 3], covered: &mut [bool]) {
+fn cover(t: [Vec2; 3], mark: u8, covered: &mut [u8]) {
     if t.iter().any(|p| !p.is_finite()) {
         return;
     }
@@ -83,7 +110,7 @@ fn cover(t: [Vec2; 3], covered: &mut [bool]) {
                 edge(t[0], t[1], p),
             ];
             if w.iter().all(|&w| w * area >= 0.0) {
-                covered[j * GRID + i] = true;
+                covered[j * GRID + i] |= mark;
             }
         }
     }
@@ -159,7 +186,7 @@ mod tests {
             }
         }
         let traced = empty as f32 / (GRID * GRID) as f32;
-        let projected = empty_view_share(&scene, &camera, width, height);
+        let projected = view_coverage(&scene, &camera, width, height).empty;
         assert!(traced > 0.1 && traced < 0.9, "{traced}");
         assert!(
             (projected - traced).abs() <= 2.0 / (GRID * GRID) as f32,

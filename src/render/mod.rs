@@ -20,7 +20,7 @@ mod surface;
 pub use aov::{AovImage, AovSet, Features};
 pub use bsdf::{Bsdf, BsdfSample, fresnel_dielectric};
 pub use camera::RayGenerator;
-pub use coverage::empty_view_share;
+pub use coverage::{ViewCoverage, view_coverage};
 pub use film::{Film, Image, PixelAccumulator};
 pub use filter::{FilterKind, PixelFilter, profile as filter_profile};
 pub use integrator::{PathResult, Strategy};

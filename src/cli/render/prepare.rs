@@ -18,7 +18,7 @@ use crate::limits::check_memory;
 use crate::load::access::folder_of;
 use crate::load::load_scene_with;
 use crate::record::{sha256_file, sha256_files};
-use crate::render::{Film, RenderSettings, Strategy, empty_view_share};
+use crate::render::{Film, RenderSettings, Strategy, view_coverage};
 use crate::scene::{Camera, Scene};
 
 /// A scene ready to render, and how.
@@ -100,9 +100,13 @@ pub fn prepare(args: &Args, plan: &Plan) -> Result<Prepared> {
     let (camera, settings) = frame(args, plan, &scene, camera)?;
     // A scene lit only by its emissive surfaces gets the studio light too when the camera
     // sees mostly background: a product model whose only emitters are small details.
-    let empty_share = (args.world.environment.is_none() && scene.lit_only_by_surfaces())
-        .then(|| empty_view_share(&scene, &camera, settings.width, settings.height));
-    let object_on_nothing = empty_share.is_some_and(|share| share > OBJECT_ON_NOTHING);
+    // Not a scene of emitters alone (a neon sign in the dark): the lit object's own
+    // surfaces must be seen more than its emitters.
+    let coverage = (args.world.environment.is_none() && scene.lit_only_by_surfaces())
+        .then(|| view_coverage(&scene, &camera, settings.width, settings.height));
+    let object_on_nothing =
+        coverage.is_some_and(|c| c.empty > OBJECT_ON_NOTHING && c.surfaces > c.emitters);
+    let empty_share = coverage.filter(|_| object_on_nothing).map(|c| c.empty);
     let environment = apply_environment(&mut scene, &args.world, object_on_nothing)?;
     check_contents(args, plan, &scene, &environment, empty_share)?;
     Ok(Prepared {
