@@ -48,7 +48,7 @@ pub struct EnvironmentSetting {
 
 /// The share of the view that must be empty background for a scene lit only by its own
 /// emissive surfaces to get the default studio light too (see
-/// [`crate::render::empty_view_share`]): an object on nothing, not a lit interior.
+/// [`crate::render::view_coverage`]): an object on nothing, not a lit interior.
 pub const OBJECT_ON_NOTHING: f32 = 0.5;
 
 /// Sets the scene's environment as the options say, and says what it became.
