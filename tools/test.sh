@@ -5,4 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/dev/setup.sh
+# Library backtraces off (panics keep theirs): capturing one takes a process-wide lock, and
+# a USD stage's probe forked while a failing test's thread held it would wait for ever,
+# turning that failure into a hang.
+export RUST_LIB_BACKTRACE=0
 cargo test --locked "$@"

@@ -1,7 +1,7 @@
 """Writes small models the way other tools write the files users download: no lights, no
-camera. Run with a Python that has `trimesh`, `pygltflib` and `usd-core` (PyPI):
+camera. Run with a Python that has `trimesh`, `pygltflib`, `usd-core` and `materialx` (PyPI):
 
-    python3 -m venv /tmp/tp && /tmp/tp/bin/pip install trimesh pygltflib usd-core numpy
+    python3 -m venv /tmp/tp && /tmp/tp/bin/pip install trimesh pygltflib usd-core numpy materialx
     /tmp/tp/bin/python tools/dev/make_third_party.py tests/data/scenes/third_party
 
 - `trimesh_shapes.glb`: trimesh's glTF exporter, an icosphere on a box with colours.
@@ -11,10 +11,17 @@ camera. Run with a Python that has `trimesh`, `pygltflib` and `usd-core` (PyPI):
   UsdPreviewSurface bound.
 - `usd_core_primvar_colour.usda`: a plate whose diffuseColor reads displayColor through a
   UsdPrimvarReader_float3 (red corners on the left, blue on the right).
+- `usd_core_materialx.usda` with `materialx/looks.mtlx` (MaterialX's own Python library,
+  PyPI `materialx`): four balls whose materials reference MaterialX documents, as studios
+  keep their looks: an OpenPBR gold with a coat, a Standard Surface amber glass, a
+  Standard Surface brass whose colour is a tiled checker image (written here as a PNG),
+  and an OpenPBR surface whose colour comes from a `noise2d` node (not read: one warning).
 """
 
 import base64
+import struct
 import sys
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -158,6 +165,101 @@ def usd_core_primvar_colour(out: Path) -> None:
     stage.GetRootLayer().Save()
 
 
+def write_png(path: Path, rgb: np.ndarray) -> None:
+    """An 8-bit RGB PNG (ISO/IEC 15948: signature, IHDR, one IDAT, IEND)."""
+    height, width, _ = rgb.shape
+    rows = b"".join(b"\x00" + rgb[y].astype(np.uint8).tobytes() for y in range(height))
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header)
+                     + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+
+def materialx_looks(folder: Path) -> None:
+    """`looks.mtlx`, written with MaterialX's document API, and its checker texture."""
+    import MaterialX as mx
+
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "textures").mkdir(exist_ok=True)
+    check = (np.indices((8, 8)).sum(axis=0) % 2)[..., None]
+    write_png(folder / "textures" / "checker.png",
+              np.where(check == 1, [230, 180, 60], [60, 40, 20]))
+    doc = mx.createDocument()
+    doc.setColorSpace("lin_rec709")
+
+    def material(name: str, shader: mx.Node) -> None:
+        look = doc.addMaterialNode(name, shader)
+        assert look is not None
+
+    gold = doc.addNode("open_pbr_surface", "SR_gold", "surfaceshader")
+    gold.setInputValue("base_color", mx.Color3(1.0, 0.766, 0.336))
+    gold.setInputValue("base_metalness", 1.0)
+    gold.setInputValue("specular_roughness", 0.3)
+    gold.setInputValue("coat_weight", 0.4)
+    gold.setInputValue("coat_roughness", 0.05)
+    material("Gold", gold)
+
+    glass = doc.addNode("standard_surface", "SR_amber", "surfaceshader")
+    glass.setInputValue("transmission", 1.0)
+    glass.setInputValue("transmission_color", mx.Color3(1.0, 0.6, 0.2))
+    glass.setInputValue("specular_roughness", 0.05)
+    glass.setInputValue("specular_IOR", 1.52)
+    material("Amber", glass)
+
+    graph = doc.addNodeGraph("NG_brass")
+    graph.setFilePrefix("textures/")
+    image = graph.addNode("tiledimage", "checker", "color3")
+    image.setInputValue("file", "checker.png", "filename")
+    image.getInput("file").setColorSpace("srgb_texture")
+    image.setInputValue("uvtiling", mx.Vector2(4.0, 2.0))
+    graph.addOutput("out_color", "color3").setConnectedNode(image)
+    brass = doc.addNode("standard_surface", "SR_brass", "surfaceshader")
+    brass.setInputValue("base", 1.0)
+    brass.setInputValue("metalness", 1.0)
+    brass.setInputValue("specular_roughness", 0.35)
+    brass_colour = brass.addInput("base_color", "color3")
+    brass_colour.setNodeGraphString("NG_brass")
+    brass_colour.setOutputString("out_color")
+    material("Brass", brass)
+
+    noise = doc.addNode("noise2d", "grain", "color3")
+    noise.setInputValue("amplitude", mx.Vector3(1.0, 1.0, 1.0))
+    noisy = doc.addNode("open_pbr_surface", "SR_noisy", "surfaceshader")
+    noisy.addInput("base_color", "color3").setConnectedNode(noise)
+    noisy.setInputValue("specular_roughness", 0.6)
+    material("Noisy", noisy)
+
+    valid, why = doc.validate()
+    assert valid, why
+    mx.writeToXmlFile(doc, str(folder / "looks.mtlx"))
+
+
+def usd_core_materialx(out: Path) -> None:
+    """Four balls in a row, each bound to a Material that references a look of
+    `materialx/looks.mtlx` (`@./materialx/looks.mtlx@</MaterialX/Materials/NAME>`)."""
+    from pxr import Usd, UsdGeom, UsdShade
+
+    materialx_looks(out / "materialx")
+    stage = Usd.Stage.CreateNew(str(out / "usd_core_materialx.usda"))
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    root = UsdGeom.Xform.Define(stage, "/Balls")
+    stage.SetDefaultPrim(root.GetPrim())
+    for i, name in enumerate(["Gold", "Amber", "Brass", "Noisy"]):
+        material = UsdShade.Material.Define(stage, f"/Balls/Looks/{name}")
+        material.GetPrim().GetReferences().AddReference(
+            "./materialx/looks.mtlx", f"/MaterialX/Materials/{name}")
+        ball = UsdGeom.Sphere.Define(stage, f"/Balls/{name}Ball")
+        ball.CreateRadiusAttr(0.45)
+        ball.AddTranslateOp().Set((i - 1.5, 0.5, 0.0))
+        UsdShade.MaterialBindingAPI.Apply(ball.GetPrim()).Bind(material)
+    stage.GetRootLayer().Save()
+
+
 if __name__ == "__main__":
     out = Path(sys.argv[1])
     out.mkdir(parents=True, exist_ok=True)
@@ -165,3 +267,4 @@ if __name__ == "__main__":
     pygltflib_plate(out)
     usd_core_disc(out)
     usd_core_primvar_colour(out)
+    usd_core_materialx(out)

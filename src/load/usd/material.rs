@@ -6,6 +6,7 @@ use glam::{Affine2, Vec2, Vec3};
 use openusd::sdf;
 
 use super::UsdLoader;
+use super::mtlx_surface;
 use super::resolver::{package_file, read_asset};
 use super::value::{as_f64, as_token, as_vec3};
 use crate::load::images::{decode_environment, decode_texture};
@@ -58,9 +59,19 @@ impl UsdLoader {
         m
     }
 
-    /// A `UsdPreviewSurface` material, mapped as glTF's are.
+    /// A material from its MaterialX surface (`outputs:mtlx:surface`) when that is a model
+    /// gridtrace reads, the richer description where a file has both (Blender's preview
+    /// surface has no transmission, its OpenPBR surface does); else from its surface
+    /// shader, a `UsdPreviewSurface` mapped as glTF's materials are.
     pub(super) fn convert_material(&mut self, material: &sdf::Path) -> Material {
         let name = material.as_str().to_string();
+        if let Some(shader) = self.connected_prim(material, "outputs:mtlx:surface")
+            && self
+                .get_token(&shader, "info:id")
+                .is_some_and(|id| mtlx_surface::is_read(&id))
+        {
+            return self.convert_mtlx_surface(&shader, name);
+        }
         let surface = self.compute_surface_source(material);
         let Some(shader) = surface else {
             self.warn(format!(
@@ -69,9 +80,9 @@ impl UsdLoader {
             return Material::default_grey(name);
         };
         let id = self.get_token(&shader, "info:id").unwrap_or_default();
-        if id != "UsdPreviewSurface" {
+        if id != "UsdPreviewSurface" && id != "ND_UsdPreviewSurface_surfaceshader" {
             self.warn(format!(
-                "{name}: surface shader '{id}' is not UsdPreviewSurface; using grey plastic"
+                "{name}: surface shader '{id}' is not a model gridtrace reads (UsdPreviewSurface, MaterialX open_pbr_surface, standard_surface, gltf_pbr); using grey plastic"
             ));
             return Material::default_grey(name);
         }
@@ -154,9 +165,6 @@ impl UsdLoader {
             transmission: (1.0 - opacity).clamp(0.0, 1.0),
             ..Pbr::default()
         };
-        if let Some(weight) = self.materialx_transmission(material) {
-            pbr.transmission = pbr.transmission.max(weight);
-        }
         if self.input_f32(&shader, "inputs:useSpecularWorkflow") == Some(1.0) {
             // The specular workflow gives F0 directly and has no metals.
             self.warn_if_connected(&shader, "inputs:specularColor", &name);
@@ -208,6 +216,20 @@ impl UsdLoader {
         default: f32,
         material: &str,
     ) -> (f32, Option<ChannelRef>) {
+        if let Some(node) = self.connected_prim(shader, input)
+            && self.get_token(&node, "info:id").as_deref() != Some("UsdUVTexture")
+        {
+            return match self.node_texture(&node, input, material) {
+                Some(t) => (
+                    1.0,
+                    Some(ChannelRef {
+                        texture: t.reference,
+                        channel: t.channel,
+                    }),
+                ),
+                None => (self.input_f32(shader, input).unwrap_or(default), None),
+            };
+        }
         let channel =
             self.connected_output(shader, input)
                 .and_then(|output| match output.as_str() {
@@ -267,10 +289,10 @@ impl UsdLoader {
     ) -> Option<(TextureRef, Vec3)> {
         let node = self.connected_prim(shader, input)?;
         if self.get_token(&node, "info:id").as_deref() != Some("UsdUVTexture") {
-            self.warn(format!(
-                "{material}: {input} is connected to something other than a UsdUVTexture; ignored"
-            ));
-            return None;
+            // A MaterialX document's UsdPreviewSurface reads MaterialX image nodes; any
+            // other node is named in a warning there.
+            let texture = self.node_texture(&node, input, material)?;
+            return Some((texture.reference, Vec3::ONE));
         }
         let asset = match self.input_value(&node, "inputs:file") {
             Some(sdf::Value::AssetPath(a)) => a,
@@ -400,23 +422,6 @@ impl UsdLoader {
                 })?;
         self.texture_paths.push(file);
         read_asset(resolved).map_err(|e| format!("'{authored}' ({resolved}): {e}"))
-    }
-
-    /// Transmission from a MaterialX surface beside the preview one. Blender's USD export
-    /// writes none into its UsdPreviewSurface (its glass arrives with opacity 1); with the
-    /// exporter's "MaterialX network" option it also writes an OpenPBR surface
-    /// (`outputs:mtlx:surface`) whose `transmission_weight` says it (Standard Surface's
-    /// `transmission` likewise).
-    fn materialx_transmission(&self, material: &sdf::Path) -> Option<f32> {
-        let shader = self.connected_prim(material, "outputs:mtlx:surface")?;
-        let input = match self.get_token(&shader, "info:id")?.as_str() {
-            "ND_open_pbr_surface_surfaceshader" => "inputs:transmission_weight",
-            "ND_standard_surface_surfaceshader" => "inputs:transmission",
-            _ => return None,
-        };
-        self.input_f32(&shader, input)
-            .filter(|w| w.is_finite())
-            .map(|w| w.clamp(0.0, 1.0))
     }
 
     fn input_f32(&self, prim: &sdf::Path, input: &str) -> Option<f32> {

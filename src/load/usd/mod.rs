@@ -20,13 +20,15 @@ mod instancer;
 mod light;
 mod material;
 mod mesh;
+mod mtlx_layer;
+mod mtlx_surface;
 mod network;
 mod probe;
 mod resolver;
 mod skel;
 mod value;
 
-use resolver::{ConfinedResolver, MAX_MISSING_LAYERS, Refusals, Skipped};
+use resolver::{ConfinedResolver, MAX_MISSING_LAYERS, Notes, Refusals, Skipped};
 use value::{as_f64, as_token, value};
 
 use super::{AssetRoots, LoadError, LoadOptions, Loaded};
@@ -109,6 +111,7 @@ fn read_stage(
     }
     let refused = Refusals::default();
     let skipped = Skipped::default();
+    let notes = Notes::default();
     let refusal = |refused: &Refusals| {
         let first = refused.lock().ok()?.first().cloned()?;
         Some(invalid(first))
@@ -118,6 +121,7 @@ fn read_stage(
             roots.clone(),
             refused.clone(),
             skipped.clone(),
+            notes.clone(),
         ))
         .open(name)
         .map_err(|e| {
@@ -142,6 +146,7 @@ fn read_stage(
         texture_paths: Vec::new(),
         from_blender: false,
         warnings: Vec::new(),
+        warned: std::collections::HashSet::new(),
     };
     // Blender signs its exports in the layer's `doc` ("Blender v5.0.1").
     loader.from_blender = loader
@@ -179,6 +184,11 @@ fn read_stage(
             errors.len() - SHOWN_COMPOSITION_ERRORS
         ));
     }
+    if let Ok(mut notes) = notes.lock() {
+        for note in notes.drain(..) {
+            loader.warnings.push(note);
+        }
+    }
     if let Ok(skipped) = skipped.lock()
         && let Some(first) = &skipped.first
     {
@@ -193,7 +203,7 @@ fn read_stage(
         .stage
         .layer_identifiers()
         .into_iter()
-        .map(PathBuf::from)
+        .map(|layer| PathBuf::from(mtlx_layer::document_of(&layer).unwrap_or(&layer)))
         .chain(loader.texture_paths)
         .filter(|file| file.is_file() && file.canonicalize().ok() != own)
         .map(Dependency::whole)
@@ -240,6 +250,8 @@ struct UsdLoader {
     /// True for files Blender wrote, whose sun strengths follow Blender's convention.
     from_blender: bool,
     warnings: Vec<String>,
+    /// Warnings given once however often their cause is met.
+    warned: std::collections::HashSet<String>,
 }
 
 /// Any prim seen through the `Xformable` schema, whose `xformOpOrder` composition the crate
@@ -262,6 +274,12 @@ impl UsdLoader {
     fn warn(&mut self, what: String) {
         self.warnings
             .push(format!("{}: {what}", self.path.display()));
+    }
+
+    fn warn_once(&mut self, what: String) {
+        if self.warned.insert(what.clone()) {
+            self.warn(what);
+        }
     }
 
     fn invalid(&self, what: String) -> LoadError {

@@ -10,6 +10,7 @@ use std::sync::{Arc, Mutex};
 
 use openusd::ar::{self, Asset, ResolvedPath, Resolver};
 
+use super::mtlx_layer::{LAYER_SUFFIX, document_of, is_document, translate};
 use crate::limits::memory_left;
 use crate::load::access::{AccessError, AssetRoots, read_regular_file};
 
@@ -20,6 +21,9 @@ pub const MAX_TEXT_NESTING: usize = 500;
 
 /// Refusals met while the stage was composed, as messages.
 pub type Refusals = Arc<Mutex<Vec<String>>>;
+
+/// Warnings met while MaterialX documents were read as layers, one line each.
+pub type Notes = Arc<Mutex<Vec<String>>>;
 
 /// Missing layers a stage may name before the rest are no longer looked for: openusd
 /// gathers its composition errors by comparing each new one with all before it, so its
@@ -33,6 +37,7 @@ pub struct ConfinedResolver {
     refused: Refusals,
     /// Missing text layers past [`MAX_MISSING_LAYERS`], stood in for by empty layers.
     skipped: Skipped,
+    notes: Notes,
     missing: std::sync::atomic::AtomicUsize,
 }
 
@@ -53,12 +58,18 @@ const EMPTY_LAYER: &[u8] = b"#usda 1.0\n";
 
 impl ConfinedResolver {
     /// A resolver reading only inside `roots`; refusals are added to `refused`.
-    pub fn new(roots: AssetRoots, refused: Refusals, skipped: Skipped) -> ConfinedResolver {
+    pub fn new(
+        roots: AssetRoots,
+        refused: Refusals,
+        skipped: Skipped,
+        notes: Notes,
+    ) -> ConfinedResolver {
         ConfinedResolver {
             inner: ar::DefaultResolver::new(),
             roots,
             refused,
             skipped,
+            notes,
             missing: std::sync::atomic::AtomicUsize::new(0),
         }
     }
@@ -93,6 +104,23 @@ impl ConfinedResolver {
         self.roots.resolve(Path::new("/"), file).map(drop)
     }
 
+    /// The layer a MaterialX document translates to; its warnings go to the notes.
+    fn open_document(&self, document: &str) -> io::Result<Box<dyn Asset>> {
+        let bytes = read_asset(document)?;
+        let xml = std::str::from_utf8(&bytes).map_err(|_| {
+            io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("{document}: not UTF-8 text"),
+            )
+        })?;
+        let layer = translate(xml, document)
+            .map_err(|why| io::Error::new(io::ErrorKind::InvalidData, why))?;
+        if let Ok(mut notes) = self.notes.lock() {
+            notes.extend(layer.warnings);
+        }
+        Ok(Box::new(io::Cursor::new(layer.text.into_bytes())))
+    }
+
     fn refuse(&self, why: String) {
         if let Ok(mut refused) = self.refused.lock()
             && !refused.contains(&why)
@@ -114,6 +142,14 @@ impl Resolver for ConfinedResolver {
         // Relative identifiers (no anchor) would be searched for in the working folder.
         let anchored = Path::new(package_file(asset_path)).is_absolute();
         match self.check(asset_path) {
+            // A MaterialX document is read as the layer it translates to.
+            Ok(()) if anchored && is_document(asset_path) => {
+                let resolved = self.inner.resolve(asset_path)?;
+                Some(ResolvedPath::new(format!(
+                    "{}{LAYER_SUFFIX}",
+                    resolved.to_string_lossy()
+                )))
+            }
             Ok(()) if anchored => self.inner.resolve(asset_path),
             Ok(()) if is_layer(asset_path) => {
                 self.refuse(format!(
@@ -151,6 +187,9 @@ impl Resolver for ConfinedResolver {
         if let Err(why) = self.check(&name) {
             self.refuse(why.to_string());
             return Err(io::Error::other(why.to_string()));
+        }
+        if let Some(document) = document_of(&name) {
+            return self.open_document(document);
         }
         let bytes = read_asset(&name)?;
         if !bytes.starts_with(b"PXR-USDC") && !bytes.starts_with(b"PK") {
@@ -284,10 +323,11 @@ fn declared_members(archive: &mut (impl io::Read + io::Seek)) -> Option<u64> {
     }
 }
 
-/// True for paths that name a layer (or a package of layers) by their extension.
+/// True for paths that name a layer (or a package of layers, or a MaterialX document read
+/// as a layer) by their extension.
 pub fn is_layer(path: &str) -> bool {
     let file = package_file(path).to_ascii_lowercase();
-    [".usd", ".usda", ".usdc", ".usdz"]
+    [".usd", ".usda", ".usdc", ".usdz", ".mtlx"]
         .iter()
         .any(|e| file.ends_with(e))
 }
