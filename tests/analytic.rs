@@ -543,6 +543,7 @@ fn normal_mapped_floor(mut b: SceneBuilder, material: usize, mapped: Vec3) -> (S
             encoded.z.round() as u16,
             65535,
         ]],
+        tiles: Vec::new(),
     });
     let mut scene = b.build();
     let m = &mut scene.meshes[mesh];

@@ -34,6 +34,7 @@ fn checker() -> Texture {
         width: 4,
         height: 4,
         texels: (0..16).map(|i| colour(i % 4, i / 4)).collect(),
+        tiles: Vec::new(),
     }
 }
 

@@ -490,6 +490,7 @@ fn glass_made_by_a_metallic_texture_is_glass_inside_too() {
                 width: 1,
                 height: 1,
                 texels: vec![[0, 65535, 0, 65535]],
+                tiles: Vec::new(),
             });
             let mut material = Material::new(
                 "textured glass",

@@ -99,3 +99,11 @@ fn normals_facing_away_from_usd_match_cycles() {
 fn specular_tints_match_cycles() {
     check("principled_specular", "glb", SPP);
 }
+
+/// Four panels, each showing one tile of a UDIM image of three tiles (1001, 1002, 1011),
+/// through Blender's USD export (`painted.<UDIM>.png`): every panel its tile's hue, each
+/// tile the right way up.
+#[test]
+fn udim_tiles_from_usd_match_cycles() {
+    check("principled_udim", "usdc", SPP);
+}

@@ -21,8 +21,9 @@ use crate::render::{AovSet, DEFAULT_MAX_DEPTH};
 /// physically based path tracer.
 ///
 /// Materials are physically based (glTF's metallic-roughness model with its specular,
-/// transmission, clear-coat and sheen extensions, which Blender's Principled BSDF and USD's
-/// UsdPreviewSurface map onto); emissive materials are area lights. Output is linear float
+/// transmission, clear-coat and sheen extensions, which Blender's Principled BSDF, USD's
+/// UsdPreviewSurface and MaterialX's OpenPBR and Standard Surface map onto); emissive
+/// materials are area lights. Output is linear float
 /// OpenEXR (.exr) or 8-bit sRGB PNG (.png), chosen by the output file's extension.
 ///
 /// A long render can be split: `--samples A..B` renders only those samples of every pixel,

@@ -24,6 +24,7 @@ pub fn decode_texture(name: String, bytes: &[u8]) -> Result<Texture, String> {
         width,
         height,
         texels: rgba.pixels().map(|p| p.0).collect(),
+        tiles: Vec::new(),
     })
 }
 
@@ -72,6 +73,7 @@ fn decode_basis(name: String, bytes: &[u8]) -> Result<Texture, String> {
             .chunks_exact(4)
             .map(|p| [p[0], p[1], p[2], p[3]].map(|c| u16::from(c) * 257))
             .collect(),
+        tiles: Vec::new(),
     })
 }
 

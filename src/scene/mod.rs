@@ -20,7 +20,10 @@ pub use light::{Light, LightKind};
 pub use material::{AlphaMode, ChannelRef, Material, MaterialTextures, Pbr, f0_of_ior};
 pub use mesh::Mesh;
 pub use motion::{Motion, TimeSlice};
-pub use texture::{ColorSpace, Filter, Texture, TextureRef, Wrap, linear_to_srgb, srgb_to_linear};
+pub use texture::{
+    ColorSpace, Filter, Texture, TextureRef, UDIM_FIRST, UDIM_LAST, Wrap, linear_to_srgb,
+    srgb_to_linear,
+};
 
 use glam::Affine3A;
 

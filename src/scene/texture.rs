@@ -20,7 +20,16 @@ pub struct Texture {
     pub height: u32,
     /// RGBA, rows top to bottom, each channel 0..=65535.
     pub texels: Vec<[u16; 4]>,
+    /// A UDIM set's tiles by number, sorted, each one image (its own `tiles` empty); empty
+    /// for an ordinary image.
+    pub tiles: Vec<(u32, Texture)>,
 }
+
+/// The first UDIM tile number, and how many tiles a row of the UDIM grid holds.
+pub const UDIM_FIRST: u32 = 1001;
+const UDIM_ROW: u32 = 10;
+/// The last UDIM tile number: ten columns, one hundred rows.
+pub const UDIM_LAST: u32 = UDIM_FIRST + UDIM_ROW * 100 - 1;
 
 /// How texture coordinates outside [0, 1] are brought back in (glTF sampler `wrapS/T`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -89,6 +98,9 @@ impl Texture {
     /// The filtered value at texture coordinates `uv` ((0, 0) = top-left of the image, as
     /// glTF defines them), decoded in `space`.
     pub fn sample(&self, reference: &TextureRef, uv: Vec2, space: ColorSpace) -> Vec4 {
+        if !self.tiles.is_empty() {
+            return self.sample_tile(reference, uv, space);
+        }
         if self.texels.is_empty() {
             return Vec4::ONE;
         }
@@ -118,9 +130,39 @@ impl Texture {
         }
     }
 
+    /// A UDIM set looked up: the tile holding the (transformed) coordinates, numbered
+    /// 1001 + ⌊s⌋ + 10·⌊t⌋ in USD's st (t = 1 − v here), read at the coordinates' fraction
+    /// with the reference's wrap modes applied within the tile (filtering at a repeating
+    /// tile's edge reads its opposite edge, as Cycles does). Where no tile is, the value is
+    /// neutral (1), as for an image that could not be read.
+    fn sample_tile(&self, reference: &TextureRef, uv: Vec2, space: ColorSpace) -> Vec4 {
+        let uv = reference.transform.transform_point2(uv);
+        let st = Vec2::new(uv.x, 1.0 - uv.y);
+        let cell = st.floor();
+        if !(0.0..UDIM_ROW as f32).contains(&cell.x) || !(0.0..100.0).contains(&cell.y) {
+            return Vec4::ONE;
+        }
+        let number = UDIM_FIRST + cell.x as u32 + UDIM_ROW * cell.y as u32;
+        let Ok(i) = self.tiles.binary_search_by_key(&number, |(n, _)| *n) else {
+            return Vec4::ONE;
+        };
+        let local = st - cell;
+        let inside = TextureRef {
+            transform: Affine2::IDENTITY,
+            ..*reference
+        };
+        self.tiles[i]
+            .1
+            .sample(&inside, Vec2::new(local.x, 1.0 - local.y), space)
+    }
+
     /// Mean of all texels in `space`: what a texture contributes on average, for choosing
-    /// textured lights by power.
+    /// textured lights by power. A UDIM set's is the mean of its tiles'.
     pub fn mean(&self, space: ColorSpace) -> Vec4 {
+        if !self.tiles.is_empty() {
+            let sum: Vec4 = self.tiles.iter().map(|(_, t)| t.mean(space)).sum();
+            return sum / self.tiles.len() as f32;
+        }
         if self.texels.is_empty() {
             return Vec4::ONE;
         }
@@ -215,7 +257,42 @@ mod tests {
             width: 2,
             height: 2,
             texels: vec![k, w, w, k],
+            tiles: Vec::new(),
         }
+    }
+
+    /// One texel of one grey level.
+    fn grey(level: u16) -> Texture {
+        Texture {
+            name: format!("grey {level}"),
+            width: 1,
+            height: 1,
+            texels: vec![[level, level, level, 65535]],
+            tiles: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn udim_tiles_are_found_by_their_number_in_st() {
+        // Tiles 1001 (s 0–1, t 0–1), 1002 (s 1–2) and 1011 (t 1–2); here v = 1 − t.
+        let set = Texture {
+            name: "set".into(),
+            width: 1,
+            height: 1,
+            texels: Vec::new(),
+            tiles: vec![(1001, grey(0)), (1002, grey(32768)), (1011, grey(65535))],
+        };
+        let at = |u: f32, v: f32| {
+            set.sample(&TextureRef::new(0), Vec2::new(u, v), ColorSpace::Linear)
+                .x
+        };
+        assert_eq!(at(0.5, 0.5), 0.0);
+        assert!((at(1.5, 0.25) - 0.5).abs() < 1e-4);
+        assert_eq!(at(0.5, -0.5), 1.0);
+        // No tile 1012, and nothing left of s = 0: neutral.
+        assert_eq!(at(1.5, -0.5), 1.0);
+        assert_eq!(at(-0.5, 0.5), 1.0);
+        assert!((set.mean(ColorSpace::Linear).x - 0.5).abs() < 1e-4);
     }
 
     #[test]
@@ -271,6 +348,7 @@ mod tests {
             width: 1,
             height: 1,
             texels: vec![[188 * 257, 188 * 257, 188 * 257, 65535]],
+            tiles: Vec::new(),
         };
         let v = t.sample(&TextureRef::new(0), Vec2::ZERO, ColorSpace::Srgb);
         assert!((v.x - 0.5029).abs() < 1e-3 && v.w == 1.0, "{v}");

@@ -23,6 +23,10 @@ clamping, no denoising, 64 bounces, black world).
 - principled_normals: floor panels normal-mapped 15° and 45° away from the camera, and a
   coarse smooth-shaded metal ball.
 - principled_specular: dark plastic spheres with a black, a red and a white Specular Tint.
+- principled_udim: four panels whose colour is a UDIM image of three tiles (1001, 1002,
+  1011), each a gradient of its own hue, darker towards its bottom; each panel shows one tile.
+  The glTF exporter splits UDIM images into one material and image per tile; the USD exporter
+  writes `name.<UDIM>.png`.
 - principled_glass: a rough glass ball (0.2). Blender's USD exporter writes no transmission
   into its UsdPreviewSurface, so this scene's .usdc is exported with the exporter's MaterialX
   network on, whose OpenPBR surface carries `transmission_weight`.
@@ -202,6 +206,42 @@ def build_normals(scene):
     ball.data.materials.append(blender_default("CoarseMetal", (0.9, 0.9, 0.92), Metallic=1.0, Roughness=0.3))
 
 
+def build_udim(scene):
+    """A panel whose UVs span tiles 1001, 1002 (s 1–2) and 1011 (t 1–2) of a UDIM image.
+    The tiles are written as PNG files first and loaded as one tiled image, as a user's
+    painted UDIM set arrives in Blender."""
+    import tempfile
+
+    room(scene)
+    folder = tempfile.mkdtemp(prefix="udim_")
+    hues = {1001: (0.9, 0.25, 0.1), 1002: (0.1, 0.7, 0.2), 1011: (0.15, 0.3, 0.9)}
+    for number, hue in hues.items():
+        tile = make_image(f"tile{number}", 32, lambda u, v, h=hue: tuple(c * (0.25 + 0.75 * v) for c in h) + (1.0,))
+        tile.filepath_raw = os.path.join(folder, f"painted.{number}.png")
+        tile.file_format = "PNG"
+        tile.save()
+    image = bpy.data.images.load(os.path.join(folder, "painted.1001.png"))
+    image.source = "TILED"
+    assert sorted(t.number for t in image.tiles) == sorted(hues), list(image.tiles)
+    image.pack()
+    mat = blender_default("Painted", (1.0, 1.0, 1.0))
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    links.new(tex.outputs["Color"], nodes["Principled BSDF"].inputs["Base Color"])
+    # Four panels in a 2 × 2 block, each showing one tile whole (as a UV island lies in
+    # one tile): 1001 bottom left, 1002 bottom right, 1011 top left, 1001 again top right.
+    def corner(i, j):
+        return (-0.9 + 0.9 * i, 0.2 * i, 0.05 + 0.7 * j)
+
+    for (i, j), (s0, t0) in zip([(0, 0), (1, 0), (0, 1), (1, 1)], [(0, 0), (1, 0), (0, 1), (0, 0)]):
+        corners = [corner(i, j), corner(i + 1, j), corner(i + 1, j + 1), corner(i, j + 1)]
+        obj = quad(f"Panel{i}{j}", [(x - 0.02 * (1 - 2 * i), y, z) for x, y, z in corners], mat)
+        uv = obj.data.uv_layers.new(name="UVMap")
+        for loop, (ds, dt) in zip(obj.data.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
+            uv.data[loop.index].uv = (s0 + ds, t0 + dt)
+
+
 def build_specular(scene):
     """Specular Tint (glTF's specular colour): black, red and white on the same dark
     plastic; a black tint still reflects at grazing angles in Cycles."""
@@ -222,6 +262,7 @@ SCENE_TABLE = {
     "principled_glass_tints": (build_glass_tints, 2048),
     "principled_normals": (build_normals, 2048),
     "principled_specular": (build_specular, 2048),
+    "principled_udim": (build_udim, 1024),
 }
 # Glass reaches USD only through the exporter's MaterialX network.
 MATERIALX = {"principled_glass", "principled_glass_tints"}

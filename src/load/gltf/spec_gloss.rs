@@ -114,6 +114,7 @@ pub(super) fn bake(
         width,
         height,
         texels,
+        tiles: Vec::new(),
     };
     (
         texture("base colour", base),

@@ -7,12 +7,12 @@ use openusd::sdf;
 
 use super::UsdLoader;
 use super::mtlx_surface;
-use super::resolver::{package_file, read_asset};
+use super::resolver::{UDIM_TOKEN, package_file, read_asset};
 use super::value::{as_f64, as_token, as_vec3};
 use crate::load::images::{decode_environment, decode_texture};
 use crate::scene::{
-    AlphaMode, ChannelRef, ColorSpace, EnvironmentMap, Material, MaterialTextures, Pbr, TextureRef,
-    Wrap, f0_of_ior,
+    AlphaMode, ChannelRef, ColorSpace, EnvironmentMap, Material, MaterialTextures, Pbr, Texture,
+    TextureRef, UDIM_FIRST, UDIM_LAST, Wrap, f0_of_ior,
 };
 
 impl UsdLoader {
@@ -86,48 +86,53 @@ impl UsdLoader {
             ));
             return Material::default_grey(name);
         }
+        self.convert_preview_surface(&shader, name)
+    }
+
+    /// A `UsdPreviewSurface` (or MaterialX's node of it), mapped as glTF's materials are.
+    fn convert_preview_surface(&mut self, shader: &sdf::Path, name: String) -> Material {
         let mut textures = MaterialTextures {
             normal_scale: 1.0,
             ..MaterialTextures::default()
         };
         // A connected input is a texture (its scale as the factor), or the mesh's
         // displayColor through a primvar reader; else a constant.
-        let reads_display_colour = self.reads_display_colour(&shader, "inputs:diffuseColor");
+        let reads_display_colour = self.reads_display_colour(shader, "inputs:diffuseColor");
         let diffuse = if reads_display_colour {
             Vec3::ONE
         } else {
-            match self.texture_input(&shader, "inputs:diffuseColor", ColorSpace::Srgb, &name) {
+            match self.texture_input(shader, "inputs:diffuseColor", ColorSpace::Srgb, &name) {
                 Some((r, scale)) => {
                     textures.base_colour = Some(r);
                     scale
                 }
-                None => self.constant_colour(&shader, "inputs:diffuseColor", Vec3::splat(0.18)),
+                None => self.constant_colour(shader, "inputs:diffuseColor", Vec3::splat(0.18)),
             }
         };
         let emission =
-            match self.texture_input(&shader, "inputs:emissiveColor", ColorSpace::Srgb, &name) {
+            match self.texture_input(shader, "inputs:emissiveColor", ColorSpace::Srgb, &name) {
                 Some((r, scale)) => {
                     textures.emissive = Some(r);
                     scale
                 }
-                None => self.constant_colour(&shader, "inputs:emissiveColor", Vec3::ZERO),
+                None => self.constant_colour(shader, "inputs:emissiveColor", Vec3::ZERO),
             };
         if let Some((r, _)) =
-            self.texture_input(&shader, "inputs:normal", ColorSpace::Linear, &name)
+            self.texture_input(shader, "inputs:normal", ColorSpace::Linear, &name)
         {
             textures.normal = Some(r);
         }
         let mut alpha_mode = AlphaMode::Opaque;
-        let mut opacity = self.input_f32(&shader, "inputs:opacity").unwrap_or(1.0);
+        let mut opacity = self.input_f32(shader, "inputs:opacity").unwrap_or(1.0);
         if let Some((r, _)) =
-            self.texture_input(&shader, "inputs:opacity", ColorSpace::Linear, &name)
+            self.texture_input(shader, "inputs:opacity", ColorSpace::Linear, &name)
         {
             // Opacity from a texture's alpha (Blender's wiring) cuts out at the threshold,
             // or blends without one. The base-colour texture carries that alpha here.
             if textures.base_colour.is_none_or(|b| b.texture == r.texture) {
                 textures.base_colour.get_or_insert(r);
                 let threshold = self
-                    .input_f32(&shader, "inputs:opacityThreshold")
+                    .input_f32(shader, "inputs:opacityThreshold")
                     .unwrap_or(0.0);
                 alpha_mode = if threshold > 0.0 {
                     AlphaMode::Mask { cutoff: threshold }
@@ -141,15 +146,15 @@ impl UsdLoader {
             }
             opacity = 1.0;
         }
-        let ior = self.constant_scalar(&shader, "inputs:ior", 1.5, &name);
+        let ior = self.constant_scalar(shader, "inputs:ior", 1.5, &name);
         let (metallic, metallic_texture) =
-            self.scalar_input(&shader, "inputs:metallic", 0.0, &name);
+            self.scalar_input(shader, "inputs:metallic", 0.0, &name);
         let (roughness, roughness_texture) =
-            self.scalar_input(&shader, "inputs:roughness", 0.5, &name);
+            self.scalar_input(shader, "inputs:roughness", 0.5, &name);
         let (clearcoat, clearcoat_texture) =
-            self.scalar_input(&shader, "inputs:clearcoat", 0.0, &name);
+            self.scalar_input(shader, "inputs:clearcoat", 0.0, &name);
         let (clearcoat_roughness, clearcoat_roughness_texture) =
-            self.scalar_input(&shader, "inputs:clearcoatRoughness", 0.01, &name);
+            self.scalar_input(shader, "inputs:clearcoatRoughness", 0.01, &name);
         textures.metallic = metallic_texture;
         textures.roughness = roughness_texture;
         textures.clearcoat = clearcoat_texture;
@@ -165,14 +170,14 @@ impl UsdLoader {
             transmission: (1.0 - opacity).clamp(0.0, 1.0),
             ..Pbr::default()
         };
-        if self.input_f32(&shader, "inputs:useSpecularWorkflow") == Some(1.0) {
+        if self.input_f32(shader, "inputs:useSpecularWorkflow") == Some(1.0) {
             // The specular workflow gives F0 directly and has no metals.
-            self.warn_if_connected(&shader, "inputs:specularColor", &name);
-            let specular = self.constant_colour(&shader, "inputs:specularColor", Vec3::ZERO);
+            self.warn_if_connected(shader, "inputs:specularColor", &name);
+            let specular = self.constant_colour(shader, "inputs:specularColor", Vec3::ZERO);
             pbr.metallic = 0.0;
             textures.metallic = None;
             pbr.specular_colour = specular / f0_of_ior(ior).max(1e-4);
-        } else if let Some(level) = self.input_f32(&shader, "inputs:specular") {
+        } else if let Some(level) = self.input_f32(shader, "inputs:specular") {
             // Blender writes its "Specular IOR Level" here (not a UsdPreviewSurface input):
             // 0.5 is the plain F0 of the ior, and the level scales F0 by 2·level.
             let scale = (2.0 * level).max(0.0);
@@ -366,9 +371,14 @@ impl UsdLoader {
             return known;
         }
         let file = asset.as_str().to_string();
-        let decoded = match self.read_asset(asset).and_then(|bytes| {
-            decode_texture(file.clone(), &bytes).map_err(|e| format!("'{file}' {e}"))
-        }) {
+        let read = if resolved.contains(UDIM_TOKEN) {
+            self.udim_tiles(resolved, &file)
+        } else {
+            self.read_asset(asset).and_then(|bytes| {
+                decode_texture(file.clone(), &bytes).map_err(|e| format!("'{file}' {e}"))
+            })
+        };
+        let decoded = match read {
             Ok(texture) => Some(self.builder.add_texture(texture)),
             Err(why) => {
                 self.warn(format!(
@@ -379,6 +389,62 @@ impl UsdLoader {
         };
         self.textures.insert(key, decoded);
         decoded
+    }
+
+    /// The tiles of the UDIM set `pattern` (resolved, `<UDIM>` in place of the tile number)
+    /// as one texture: every file beside it whose name has a tile number (1001–2000)
+    /// there, each read through the file-access policy. `authored` names it in messages.
+    fn udim_tiles(&mut self, pattern: &str, authored: &str) -> Result<Texture, String> {
+        let (folder, name) = pattern.rsplit_once('/').unwrap_or((".", pattern));
+        let (before, after) = name.split_once(UDIM_TOKEN).unwrap_or((name, ""));
+        if !Path::new(folder).is_absolute() {
+            return Err(format!(
+                "'{authored}' does not resolve from the layer that names it"
+            ));
+        }
+        if folder.contains('[') || folder.contains(UDIM_TOKEN) {
+            return Err(format!(
+                "'{authored}': UDIM tiles inside a package, or a folder per tile, are not read"
+            ));
+        }
+        let entries = std::fs::read_dir(folder)
+            .map_err(|e| format!("'{authored}': its folder cannot be listed ({e})"))?;
+        let mut numbers: Vec<u32> = entries
+            .filter_map(|e| e.ok()?.file_name().into_string().ok())
+            .filter_map(|file| {
+                let digits = file.strip_prefix(before)?.strip_suffix(after)?;
+                let number: u32 = digits.parse().ok()?;
+                (digits.len() == 4 && (UDIM_FIRST..=UDIM_LAST).contains(&number)).then_some(number)
+            })
+            .collect();
+        numbers.sort_unstable();
+        if numbers.is_empty() {
+            return Err(format!(
+                "'{authored}': no UDIM tile (1001, 1002, …) is beside it"
+            ));
+        }
+        let mut tiles = Vec::with_capacity(numbers.len());
+        for number in numbers {
+            let path = format!("{folder}/{before}{number}{after}");
+            let file = self
+                .roots
+                .resolve(Path::new("/"), &path)
+                .map_err(|e| format!("'{authored}' tile {number}: {e}"))?;
+            self.texture_paths.push(file);
+            let bytes =
+                read_asset(&path).map_err(|e| format!("'{authored}' tile {number}: {e}"))?;
+            let tile = decode_texture(format!("{authored} tile {number}"), &bytes)
+                .map_err(|e| format!("'{authored}' tile {number} {e}"))?;
+            tiles.push((number, tile));
+        }
+        let (width, height) = (tiles[0].1.width, tiles[0].1.height);
+        Ok(Texture {
+            name: authored.to_string(),
+            width,
+            height,
+            texels: Vec::new(),
+            tiles,
+        })
     }
 
     /// The environment map in the image at `asset`, or `None` with a warning naming `prim`.

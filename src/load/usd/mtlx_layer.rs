@@ -557,7 +557,7 @@ fn anchor(document: &str, file: &str) -> String {
             p => parts.push(p),
         }
     }
-    let absolute = !(package.is_some() && !inner.starts_with('/'));
+    let absolute = package.is_none() || inner.starts_with('/');
     let path = format!("{}{}", if absolute { "/" } else { "" }, parts.join("/"));
     match package {
         Some(p) if !file.starts_with('/') => format!("{p}[{path}]"),

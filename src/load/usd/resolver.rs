@@ -22,6 +22,10 @@ pub const MAX_TEXT_NESTING: usize = 500;
 /// Refusals met while the stage was composed, as messages.
 pub type Refusals = Arc<Mutex<Vec<String>>>;
 
+/// What a texture path holds in place of a UDIM tile's number (`wood.<UDIM>.png`), as
+/// Blender, USD and MaterialX write it.
+pub const UDIM_TOKEN: &str = "<UDIM>";
+
 /// Warnings met while MaterialX documents were read as layers, one line each.
 pub type Notes = Arc<Mutex<Vec<String>>>;
 
@@ -161,6 +165,10 @@ impl Resolver for ConfinedResolver {
             // A missing file is the composition's business (an unresolved layer).
             Err(AccessError::Missing { .. }) if anchored && is_layer(asset_path) => {
                 self.missing_layer(asset_path)
+            }
+            // A UDIM pattern names no file itself: the loader finds its tiles.
+            Err(AccessError::Missing { .. }) if anchored && asset_path.contains(UDIM_TOKEN) => {
+                Some(ResolvedPath::new(asset_path))
             }
             Err(AccessError::Missing { .. }) => None,
             // A refused layer fails the load. A refused texture resolves to its path so
