@@ -1,7 +1,7 @@
 //! glTF extensions and storage forms read by hand-built files whose answers are known:
 //! quantised attributes (`KHR_mesh_quantization`), sparse accessors without a bufferView,
-//! `EXT_mesh_gpu_instancing`, `KHR_materials_unlit` and
-//! `KHR_materials_pbrSpecularGlossiness`.
+//! `EXT_mesh_gpu_instancing`, `KHR_materials_unlit`,
+//! `KHR_materials_pbrSpecularGlossiness` and `KHR_materials_variants`.
 
 #[path = "support/binary/mod.rs"]
 mod binary;
@@ -13,7 +13,7 @@ mod image_stats;
 use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
-use gridtrace::load::load_scene;
+use gridtrace::load::{LoadOptions, load_scene, load_scene_with};
 use serde_json::{Value, json};
 
 /// Writes `document` with `buffer` as its only buffer, in a base64 data URI, and checks it
@@ -355,4 +355,46 @@ fn a_posed_node_reached_twice_is_posed_once() {
     assert_eq!(scene.instances.len(), 2);
     assert_eq!(scene.meshes.len(), 1);
     assert!(scene.meshes[0].positions.iter().all(|p| p.z == 0.5));
+}
+
+/// `KHR_materials_variants` in a file written by pygltflib (tools/dev/make_third_party.py):
+/// two squares, red by default; variant "Blue" maps both to blue, "Green" only the left one
+/// (the right keeps its own red). Variants are picked by name or index; an unknown one is an
+/// error listing the file's.
+#[test]
+fn material_variants_choose_each_primitives_material() {
+    let path = Path::new("tests/data/scenes/third_party/pygltflib_variants.gltf");
+    let colours = |variant: Option<&str>| -> Vec<Vec3> {
+        let options = LoadOptions {
+            material_variant: variant.map(String::from),
+            ..LoadOptions::default()
+        };
+        let loaded = load_scene_with(path, &options).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        let scene = loaded.scene;
+        let mut meshes: Vec<_> = scene.meshes.iter().collect();
+        meshes.sort_by(|a, b| a.positions[0].x.total_cmp(&b.positions[0].x));
+        meshes
+            .iter()
+            .map(|m| scene.materials[m.material].pbr.base_colour)
+            .collect()
+    };
+    let (red, blue, green) = (
+        Vec3::new(0.8, 0.1, 0.1),
+        Vec3::new(0.1, 0.1, 0.8),
+        Vec3::new(0.1, 0.8, 0.1),
+    );
+    assert_eq!(colours(None), [red, red]);
+    assert_eq!(colours(Some("Blue")), [blue, blue]);
+    assert_eq!(colours(Some("Green")), [green, red]);
+    assert_eq!(colours(Some("1")), [green, red]);
+    let options = LoadOptions {
+        material_variant: Some("Gold".into()),
+        ..LoadOptions::default()
+    };
+    let error = load_scene_with(path, &options).unwrap_err().to_string();
+    assert!(
+        error.contains("pygltflib_variants.gltf") && error.contains("0 'Blue', 1 'Green'"),
+        "{error}"
+    );
 }

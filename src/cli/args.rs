@@ -228,6 +228,11 @@ pub struct LoadArgs {
     #[arg(long, value_name = "NAME|INDEX", requires = "frame")]
     pub animation: Option<String>,
 
+    /// The glTF material variant (KHR_materials_variants) to render, by name or index.
+    /// [default: each primitive's own material]
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub material_variant: Option<String>,
+
     /// Levels of Catmull–Clark refinement for USD meshes whose subdivisionScheme asks for
     /// it (Blender exports a Subdivision modifier as its cage with catmullClark); 0 renders
     /// the cage. Each level has four times the faces. [default: 2, Blender's render level]

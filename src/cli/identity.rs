@@ -65,6 +65,9 @@ fn load_label(options: &LoadOptions) -> String {
     if let Some(animation) = &options.animation {
         label += &format!(" animation={animation}");
     }
+    if let Some(variant) = &options.material_variant {
+        label += &format!(" material-variant={variant}");
+    }
     if let Some(levels) = options.subdivision_level {
         label += &format!(" subdivision-level={levels}");
     }

@@ -49,6 +49,9 @@ pub struct LoadOptions {
     pub fps: Option<f64>,
     /// The glTF animation to evaluate, by name or index (`None`: the first).
     pub animation: Option<String>,
+    /// The glTF material variant (`KHR_materials_variants`) to render, by name or index
+    /// (`None`: the primitives' own materials).
+    pub material_variant: Option<String>,
     /// Folders a scene may read besides its own (`--asset-path`); see [`access`].
     pub asset_paths: Vec<PathBuf>,
     /// Levels of Catmull–Clark refinement for USD meshes that ask for subdivision

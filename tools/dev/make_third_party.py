@@ -7,6 +7,9 @@ camera. Run with a Python that has `trimesh`, `pygltflib`, `usd-core` and `mater
 - `trimesh_shapes.glb`: trimesh's glTF exporter, an icosphere on a box with colours.
 - `pygltflib_plate.gltf`: a flat square lying in the ground plane (Y up), written
   accessor by accessor with pygltflib, as a flat object such as a watch would be.
+- `pygltflib_variants.gltf`: two squares side by side with `KHR_materials_variants`: both
+  red by default; variant "Blue" makes both blue, variant "Green" makes only the left
+  one green (the right one has no mapping for it and keeps red).
 - `usd_core_disc.usda`: Pixar's USD library, a thin Z-up cylinder (a coin) with a
   UsdPreviewSurface bound.
 - `usd_core_primvar_colour.usda`: a plate whose diffuseColor reads displayColor through a
@@ -97,6 +100,60 @@ def pygltflib_plate(out: Path) -> None:
         ],
     )
     gltf.save(str(out / "pygltflib_plate.gltf"))
+
+
+def pygltflib_variants(out: Path) -> None:
+    import pygltflib as g
+
+    # Two unit squares in the ground plane, x in [-2, 0] and [0, 2].
+    left = np.array([[-2, 0, -1], [0, 0, -1], [0, 0, 1], [-2, 0, 1]], dtype=np.float32)
+    right = left + np.array([2, 0, 0], dtype=np.float32)
+    indices = np.array([0, 2, 1, 0, 3, 2], dtype=np.uint16)
+    blob = left.tobytes() + right.tobytes() + indices.tobytes()
+
+    def colour(name, rgb):
+        return g.Material(
+            name=name,
+            pbrMetallicRoughness=g.PbrMetallicRoughness(
+                baseColorFactor=[*rgb, 1.0], metallicFactor=0.0, roughnessFactor=0.7),
+            doubleSided=True,
+        )
+
+    def square(position, mappings):
+        return g.Primitive(
+            attributes=g.Attributes(POSITION=position), indices=2, material=0,
+            extensions={"KHR_materials_variants": {"mappings": mappings}},
+        )
+
+    def bounds(points):
+        return dict(min=points.min(axis=0).tolist(), max=points.max(axis=0).tolist())
+
+    gltf = g.GLTF2(
+        scene=0,
+        scenes=[g.Scene(nodes=[0])],
+        nodes=[g.Node(mesh=0, name="squares")],
+        meshes=[g.Mesh(primitives=[
+            square(0, [{"material": 1, "variants": [0]}, {"material": 2, "variants": [1]}]),
+            square(1, [{"material": 1, "variants": [0]}]),
+        ])],
+        materials=[colour("Red", [0.8, 0.1, 0.1]), colour("Blue", [0.1, 0.1, 0.8]),
+                   colour("Green", [0.1, 0.8, 0.1])],
+        extensionsUsed=["KHR_materials_variants"],
+        extensions={"KHR_materials_variants": {"variants": [{"name": "Blue"}, {"name": "Green"}]}},
+        accessors=[
+            g.Accessor(bufferView=0, componentType=g.FLOAT, count=4, type=g.VEC3, **bounds(left)),
+            g.Accessor(bufferView=1, componentType=g.FLOAT, count=4, type=g.VEC3, **bounds(right)),
+            g.Accessor(bufferView=2, componentType=g.UNSIGNED_SHORT, count=6, type=g.SCALAR),
+        ],
+        bufferViews=[
+            g.BufferView(buffer=0, byteOffset=0, byteLength=left.nbytes),
+            g.BufferView(buffer=0, byteOffset=left.nbytes, byteLength=right.nbytes),
+            g.BufferView(buffer=0, byteOffset=2 * left.nbytes, byteLength=indices.nbytes),
+        ],
+        buffers=[g.Buffer(byteLength=len(blob), uri="data:application/octet-stream;base64,"
+                          + base64.b64encode(blob).decode())],
+    )
+    gltf.save(str(out / "pygltflib_variants.gltf"))
 
 
 def usd_core_disc(out: Path) -> None:
@@ -265,6 +322,7 @@ if __name__ == "__main__":
     out.mkdir(parents=True, exist_ok=True)
     trimesh_shapes(out)
     pygltflib_plate(out)
+    pygltflib_variants(out)
     usd_core_disc(out)
     usd_core_primvar_colour(out)
     usd_core_materialx(out)

@@ -60,6 +60,7 @@ pub fn read_request(args: &Args) -> Result<Request<'_>> {
         frame: loading.frame,
         fps: loading.fps,
         animation: loading.animation.clone(),
+        material_variant: loading.material_variant.clone(),
         asset_paths: loading.asset_path.clone(),
         subdivision_level: loading.subdivision_level,
         hard_falloff: loading.soft_falloff == SoftFalloffChoice::Off,

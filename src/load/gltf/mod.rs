@@ -43,6 +43,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "EXT_texture_webp",
     "KHR_texture_basisu",
     "KHR_materials_unlit",
+    "KHR_materials_variants",
     "EXT_mesh_gpu_instancing",
     "KHR_materials_pbrSpecularGlossiness",
 ];
@@ -116,7 +117,12 @@ pub fn load_bytes_with(
             .frame
             .map(|frame| (frame / options.frames_per_second()) as f32),
         animation: options.animation.clone(),
+        variant: None,
         warnings,
+    };
+    loader.variant = match &options.material_variant {
+        Some(asked) => Some(loader.find_variant(&document, asked)?),
+        None => None,
     };
     loader.warn_about_unreadable_images(&document);
     for material in document.materials() {
@@ -296,6 +302,8 @@ struct GltfLoader {
     time: Option<f32>,
     /// The animation asked for by name or index (`None`: the first).
     animation: Option<String>,
+    /// The material variant rendered, by index (`None`: the primitives' own materials).
+    variant: Option<u32>,
     warnings: Vec<String>,
 }
 
@@ -312,8 +320,47 @@ impl GltfLoader {
             .push(format!("{}: {what}", self.path.display()));
     }
 
+    /// The variant named or numbered `asked`, or an error listing the file's variants.
+    fn find_variant(&self, document: &gltf::Document, asked: &str) -> Result<u32, LoadError> {
+        let names: Vec<&str> = document
+            .variants()
+            .map(|v| v.map(|v| v.name()).collect())
+            .unwrap_or_default();
+        let found = names
+            .iter()
+            .position(|n| *n == asked)
+            .or_else(|| asked.parse::<usize>().ok().filter(|&i| i < names.len()));
+        match found {
+            Some(i) => Ok(i as u32),
+            None if names.is_empty() => Err(self.invalid(format!(
+                "--material-variant {asked}: the file has no material variants (KHR_materials_variants)"
+            ))),
+            None => Err(self.invalid(format!(
+                "--material-variant {asked}: no such variant; the file has {}",
+                names
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| format!("{i} '{n}'"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))),
+        }
+    }
+
+    /// The material index of `primitive` in the variant rendered: the mapping that lists
+    /// the variant, else the primitive's own material (`KHR_materials_variants`).
+    fn material_index(&self, primitive: &gltf::Primitive) -> Option<usize> {
+        let mapped = self.variant.and_then(|v| {
+            primitive
+                .mappings()
+                .find(|m| m.variants().contains(&v))
+                .map(|m| m.material().index())
+        });
+        mapped.unwrap_or_else(|| primitive.material().index())
+    }
+
     fn material_for(&mut self, primitive: &gltf::Primitive) -> usize {
-        if let Some(i) = primitive.material().index() {
+        if let Some(i) = self.material_index(primitive) {
             return i;
         }
         *self

@@ -218,9 +218,8 @@ impl GltfLoader {
             indices,
             material,
         };
-        let normal_uvs = primitive
-            .material()
-            .index()
+        let normal_uvs = self
+            .material_index(primitive)
             .and_then(|m| self.normal_mapped.get(m).copied().flatten());
         if let Some(set) = normal_uvs
             && mesh.tangents.is_empty()

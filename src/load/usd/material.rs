@@ -117,8 +117,7 @@ impl UsdLoader {
                 }
                 None => self.constant_colour(shader, "inputs:emissiveColor", Vec3::ZERO),
             };
-        if let Some((r, _)) =
-            self.texture_input(shader, "inputs:normal", ColorSpace::Linear, &name)
+        if let Some((r, _)) = self.texture_input(shader, "inputs:normal", ColorSpace::Linear, &name)
         {
             textures.normal = Some(r);
         }
@@ -147,8 +146,7 @@ impl UsdLoader {
             opacity = 1.0;
         }
         let ior = self.constant_scalar(shader, "inputs:ior", 1.5, &name);
-        let (metallic, metallic_texture) =
-            self.scalar_input(shader, "inputs:metallic", 0.0, &name);
+        let (metallic, metallic_texture) = self.scalar_input(shader, "inputs:metallic", 0.0, &name);
         let (roughness, roughness_texture) =
             self.scalar_input(shader, "inputs:roughness", 0.5, &name);
         let (clearcoat, clearcoat_texture) =
