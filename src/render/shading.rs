@@ -8,7 +8,7 @@ use super::Renderer;
 use super::bsdf::Bsdf;
 use super::sampler::Sampler;
 use super::surface::Surface;
-use crate::scene::{AlphaMode, ChannelRef, ColorSpace, Material, Mesh, Scene, TextureRef};
+use crate::scene::{AlphaMode, ChannelRef, ColorSpace, Material, Mesh, Pbr, Scene, TextureRef};
 
 /// A material evaluated at a point.
 #[derive(Clone, Copy, Debug)]
@@ -25,6 +25,9 @@ pub struct Shading {
     /// The clear coat's own normal where its normal map gives one (on the same side as
     /// `normal`).
     pub coat_normal: Option<Vec3>,
+    /// The direction an anisotropic material's glossy lobes are stretched along (world
+    /// space, in the tangent plane).
+    pub anisotropy_direction: Option<Vec3>,
 }
 
 impl Shading {
@@ -49,6 +52,9 @@ impl Shading {
         }
         if self.normal != smooth {
             bsdf = bsdf.with_bump_shadowing(n, smooth);
+        }
+        if let Some(direction) = self.anisotropy_direction {
+            bsdf = bsdf.with_tangent(n, direction);
         }
         (bsdf, n)
     }
@@ -85,6 +91,7 @@ impl Renderer<'_> {
                 base_colour: material.pbr.base_colour,
                 normal: s.shading_normal,
                 coat_normal: None,
+                anisotropy_direction: None,
             };
         }
         let mesh = self.mesh_of(s);
@@ -129,12 +136,16 @@ impl Renderer<'_> {
             _ => None,
         };
         let normal = mapped(&textures.normal, textures.normal_scale).unwrap_or(s.shading_normal);
+        let anisotropy_direction = (pbr.anisotropy.strength > 0.0)
+            .then(|| self.anisotropy_direction(s, mesh, &mut pbr, lookup))
+            .flatten();
         Shading {
             bsdf: Bsdf::new(&pbr, front),
             emission,
             base_colour: pbr.base_colour,
             normal,
             coat_normal: mapped(&textures.clearcoat_normal, textures.clearcoat_normal_scale),
+            anisotropy_direction,
         }
     }
 
@@ -186,23 +197,56 @@ impl Renderer<'_> {
         w.x * mesh.colours[a] + w.y * mesh.colours[b] + w.z * mesh.colours[c]
     }
 
-    /// The shading normal bent by a tangent-space normal-map texel (glTF: RGB = XYZ in
-    /// [-1, 1], X along the tangent, Y along sign·N×T, XY scaled by `scale`).
-    fn normal_mapped(&self, s: &Surface, mesh: &Mesh, texel: Vec4, scale: f32) -> Vec3 {
+    /// The world tangent and bitangent at `s`, orthogonal to its shading normal, from the
+    /// mesh's tangents (glTF: the bitangent is sign·N×T); `None` without tangents.
+    fn tangent_frame(&self, s: &Surface, mesh: &Mesh) -> Option<(Vec3, Vec3)> {
+        if mesh.tangents.is_empty() {
+            return None;
+        }
         let [a, b, c] = s.vertices;
         let w = s.barycentrics;
         let tangent = w.x * mesh.tangents[a] + w.y * mesh.tangents[b] + w.z * mesh.tangents[c];
         let frame = &self.frames[s.instance];
         let n = s.shading_normal;
         let t = frame.world_from_object.matrix3 * tangent.truncate();
-        let t = (t - n * n.dot(t)).normalize_or_zero();
-        if t == Vec3::ZERO {
-            return n;
-        }
+        let t = (t - n * n.dot(t)).try_normalize()?;
         // A mirroring instance transform flips the bitangent's handedness.
         let handedness =
             mesh.tangents[a].w.signum() * frame.world_from_object.matrix3.determinant().signum();
-        let bitangent = handedness * n.cross(t);
+        Some((t, handedness * n.cross(t)))
+    }
+
+    /// The direction of anisotropy at `s` (`KHR_materials_anisotropy`): the texture's RG
+    /// direction in the tangent frame (default +T), turned by the rotation towards the
+    /// bitangent; the texture's blue scales the strength in `pbr`. `None` without tangents
+    /// (the lobes then keep an arbitrary axis).
+    fn anisotropy_direction(
+        &self,
+        s: &Surface,
+        mesh: &Mesh,
+        pbr: &mut Pbr,
+        lookup: impl Fn(&TextureRef, ColorSpace) -> Vec4,
+    ) -> Option<Vec3> {
+        let (t, b) = self.tangent_frame(s, mesh)?;
+        let mut direction = Vec2::X;
+        if let Some(r) = &self.scene.materials[s.material].textures.anisotropy {
+            let texel = lookup(r, ColorSpace::Linear);
+            direction = Vec2::new(2.0 * texel.x - 1.0, 2.0 * texel.y - 1.0)
+                .try_normalize()
+                .unwrap_or(Vec2::X);
+            pbr.anisotropy.strength *= texel.z;
+        }
+        let turned = Vec2::from_angle(pbr.anisotropy.rotation).rotate(direction);
+        Some(turned.x * t + turned.y * b)
+    }
+
+    /// The shading normal bent by a tangent-space normal-map texel (glTF: RGB = XYZ in
+    /// [-1, 1], X along the tangent, Y along sign·N×T, XY scaled by `scale`).
+    fn normal_mapped(&self, s: &Surface, mesh: &Mesh, texel: Vec4, scale: f32) -> Vec3 {
+        let n = s.shading_normal;
+        let Some((t, bitangent)) = self.tangent_frame(s, mesh) else {
+            return n;
+        };
         let m = Vec3::new(
             (2.0 * texel.x - 1.0) * scale,
             (2.0 * texel.y - 1.0) * scale,

@@ -37,6 +37,33 @@ pub struct Pbr {
     pub sheen_colour: Vec3,
     /// Perceptual roughness of the sheen (Charlie distribution).
     pub sheen_roughness: f32,
+    /// Stretch of the metal and specular lobes along a direction of the surface.
+    pub anisotropy: Anisotropy,
+}
+
+/// Anisotropic reflection, as `KHR_materials_anisotropy` and Blender's Principled BSDF
+/// (Anisotropic, Anisotropic Rotation) describe it: the glossy lobes are wider along one
+/// direction of the surface, given by the mesh's tangent frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Anisotropy {
+    /// 0: isotropic; up to 1: fully stretched.
+    pub strength: f32,
+    /// The direction of the stretch: radians from the tangent towards the bitangent.
+    pub rotation: f32,
+    /// How the strength widens the lobes.
+    pub model: AnisotropyModel,
+}
+
+/// How an anisotropy strength s turns roughness r (α = r²) into the widths along and
+/// across its direction.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AnisotropyModel {
+    /// `KHR_materials_anisotropy`: α along = mix(α, 1, s²), α across = α.
+    #[default]
+    Gltf,
+    /// Cycles' Principled BSDF (files Blender wrote, whose strength is Blender's
+    /// Anisotropic): α along = α/√(1 − 0.9 s), α across = α·√(1 − 0.9 s).
+    Cycles,
 }
 
 impl Default for Pbr {
@@ -55,6 +82,7 @@ impl Default for Pbr {
             clearcoat_roughness: 0.0,
             sheen_colour: Vec3::ZERO,
             sheen_roughness: 0.0,
+            anisotropy: Anisotropy::default(),
         }
     }
 }
@@ -169,6 +197,8 @@ pub struct MaterialTextures {
     pub clearcoat_normal: Option<TextureRef>,
     /// Scales the coat normal map's X and Y.
     pub clearcoat_normal_scale: f32,
+    /// `anisotropyTexture`: RG the direction in the tangent frame ([-1, 1]), B × strength.
+    pub anisotropy: Option<TextureRef>,
 }
 
 impl MaterialTextures {
@@ -187,6 +217,7 @@ impl MaterialTextures {
             || self.sheen_roughness.is_some()
             || self.normal.is_some()
             || self.clearcoat_normal.is_some()
+            || self.anisotropy.is_some()
     }
 }
 
@@ -292,6 +323,7 @@ impl Material {
 
     /// True when shading must look at textures or vertex attributes.
     pub fn varies(&self) -> bool {
-        self.textures.any() || self.vertex_colours
+        // An anisotropic lobe turns with the surface's tangent frame.
+        self.textures.any() || self.vertex_colours || self.pbr.anisotropy.strength > 0.0
     }
 }

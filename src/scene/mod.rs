@@ -17,7 +17,9 @@ pub use builder::SceneBuilder;
 pub use camera::{Camera, Projection, ThinLens};
 pub use environment::{Environment, EnvironmentMap, blender_world_rotation, map_direction, map_uv};
 pub use light::{Light, LightKind};
-pub use material::{AlphaMode, ChannelRef, Material, MaterialTextures, Pbr, f0_of_ior};
+pub use material::{
+    AlphaMode, Anisotropy, AnisotropyModel, ChannelRef, Material, MaterialTextures, Pbr, f0_of_ior,
+};
 pub use mesh::Mesh;
 pub use motion::{Motion, TimeSlice};
 pub use texture::{

@@ -7,7 +7,8 @@ use super::{GltfLoader, MAX_UV_SETS, spec_gloss, texture_transform};
 use crate::limits::check_memory;
 use crate::load::images::decode_texture;
 use crate::scene::{
-    AlphaMode, ChannelRef, Filter, Material, MaterialTextures, Pbr, TextureRef, Wrap,
+    AlphaMode, Anisotropy, AnisotropyModel, ChannelRef, Filter, Material, MaterialTextures, Pbr,
+    TextureRef, Wrap,
 };
 
 impl GltfLoader {
@@ -115,6 +116,19 @@ impl GltfLoader {
                 self.json_texture(document, &coat["clearcoatNormalTexture"], &name);
             textures.clearcoat_normal_scale =
                 json_f32(&coat["clearcoatNormalTexture"]["scale"], 1.0);
+        }
+        if let Some(anisotropy) = material.extension_value("KHR_materials_anisotropy") {
+            pbr.anisotropy = Anisotropy {
+                strength: json_f32(&anisotropy["anisotropyStrength"], 0.0).clamp(0.0, 1.0),
+                rotation: json_f32(&anisotropy["anisotropyRotation"], 0.0),
+                model: if self.from_blender {
+                    AnisotropyModel::Cycles
+                } else {
+                    AnisotropyModel::Gltf
+                },
+            };
+            textures.anisotropy =
+                self.json_texture(document, &anisotropy["anisotropyTexture"], &name);
         }
         if let Some(sheen) = material.extension_value("KHR_materials_sheen") {
             pbr.sheen_colour = json_vec3(&sheen["sheenColorFactor"], Vec3::ZERO);

@@ -25,6 +25,10 @@ use files::{SceneFiles, read_buffers};
 use super::{AssetRoots, GltfLightUnits, LoadError, LoadOptions, Loaded};
 use crate::scene::{Camera, Light, LightKind, Material, Projection, SceneBuilder};
 
+/// How Blender's glTF exporter signs its files (`asset.generator`, "Khronos glTF Blender
+/// I/O v5.0.21").
+pub const BLENDER_GENERATOR: &str = "Khronos glTF Blender I/O";
+
 /// Extensions whose meaning gridtrace implements.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
@@ -44,6 +48,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_texture_basisu",
     "KHR_materials_unlit",
     "KHR_materials_variants",
+    "KHR_materials_anisotropy",
     "EXT_mesh_gpu_instancing",
     "KHR_materials_pbrSpecularGlossiness",
 ];
@@ -118,6 +123,12 @@ pub fn load_bytes_with(
             .map(|frame| (frame / options.frames_per_second()) as f32),
         animation: options.animation.clone(),
         variant: None,
+        from_blender: document
+            .as_json()
+            .asset
+            .generator
+            .as_deref()
+            .is_some_and(|g| g.starts_with(BLENDER_GENERATOR)),
         warnings,
     };
     loader.variant = match &options.material_variant {
@@ -127,11 +138,16 @@ pub fn load_bytes_with(
     loader.warn_about_unreadable_images(&document);
     for material in document.materials() {
         let m = loader.convert_material(&document, &material);
+        // Normal maps and anisotropy need tangents: from the normal map's coordinates,
+        // else the anisotropy texture's, else the first set.
+        let anisotropic = (m.pbr.anisotropy.strength > 0.0)
+            .then(|| m.textures.anisotropy.map_or(0, |a| a.texcoord));
         loader.normal_mapped.push(
             m.textures
                 .normal
                 .or(m.textures.clearcoat_normal)
-                .map(|n| n.texcoord),
+                .map(|n| n.texcoord)
+                .or(anisotropic),
         );
         loader.builder.add_material(m);
     }
@@ -304,6 +320,9 @@ struct GltfLoader {
     animation: Option<String>,
     /// The material variant rendered, by index (`None`: the primitives' own materials).
     variant: Option<u32>,
+    /// True for files Blender's exporter wrote (`asset.generator`), whose anisotropy
+    /// strength is Blender's Anisotropic, rendered as Cycles does.
+    from_blender: bool,
     warnings: Vec<String>,
 }
 

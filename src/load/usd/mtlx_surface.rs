@@ -209,6 +209,7 @@ impl UsdLoader {
             clearcoat_roughness,
             sheen_colour: sheen_colour * sheen_weight,
             sheen_roughness,
+            ..Pbr::default()
         };
         let opacity = self.mtlx_opacity(shader, model.opacity, &name);
         Material {

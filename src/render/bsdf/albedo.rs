@@ -43,9 +43,7 @@ impl AlbedoTables {
         let mut sheen = Vec::with_capacity(N * N);
         for j in 0..N {
             let roughness = grid(j);
-            let ggx = Ggx {
-                alpha: (roughness * roughness).max(DELTA_ALPHA),
-            };
+            let ggx = Ggx::isotropic((roughness * roughness).max(DELTA_ALPHA));
             let sheen_alpha = (roughness * roughness).max(SHEEN_MIN_ALPHA);
             for i in 0..N {
                 let mu = grid(i).max(1e-4);
@@ -162,9 +160,7 @@ impl GlassTable {
                 let eta = if side == 0 { ior } else { 1.0 / ior };
                 for j in 0..GLASS_N {
                     let roughness = grid(j);
-                    let ggx = Ggx {
-                        alpha: (roughness * roughness).max(DELTA_ALPHA),
-                    };
+                    let ggx = Ggx::isotropic((roughness * roughness).max(DELTA_ALPHA));
                     for i in 0..GLASS_N {
                         let mu = grid(i).max(1e-3);
                         let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);

@@ -13,39 +13,93 @@ use std::f32::consts::{PI, TAU};
 /// within a pixel, and its pdf would overflow what f32 can weigh.
 pub const DELTA_ALPHA: f32 = 1e-3;
 
-/// GGX with width α = roughness².
+/// GGX with widths αx and αy along an axis of the tangent plane (α = roughness² when
+/// isotropic). Anisotropic GGX: Heitz 2014, §5.4; its visible normals are drawn by the
+/// same stretch (Heitz 2018, §3).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ggx {
-    /// Width: the RMS slope of the microsurface is α/√2.
-    pub alpha: f32,
+    /// Width along the axis: the RMS slope that way is αx/√2.
+    pub alpha_x: f32,
+    /// Width across the axis.
+    pub alpha_y: f32,
+    /// The axis in the local frame, as (cos, sin) of its angle from local x.
+    pub axis: Vec2,
 }
 
 impl Ggx {
-    /// The distribution of a perceptual roughness, or `None` when it is sharp enough to be a
-    /// delta lobe.
+    /// The isotropic distribution of a perceptual roughness, or `None` when it is sharp
+    /// enough to be a delta lobe.
     pub fn from_roughness(roughness: f32) -> Option<Ggx> {
         let alpha = roughness.clamp(0.0, 1.0).powi(2);
-        (alpha >= DELTA_ALPHA).then_some(Ggx { alpha })
+        (alpha >= DELTA_ALPHA).then(|| Ggx::isotropic(alpha))
     }
 
-    /// D(h): microfacet normals per unit projected area, per steradian.
+    /// Width α in every direction.
+    pub fn isotropic(alpha: f32) -> Ggx {
+        Ggx {
+            alpha_x: alpha,
+            alpha_y: alpha,
+            axis: Vec2::X,
+        }
+    }
+
+    /// Widths `alpha_x` along local x and `alpha_y` along local y, or `None` when both are
+    /// sharp enough for a delta lobe; a sharp one beside a rough one is held at
+    /// [`DELTA_ALPHA`].
+    pub fn anisotropic(alpha_x: f32, alpha_y: f32) -> Option<Ggx> {
+        (alpha_x.max(alpha_y) >= DELTA_ALPHA).then(|| Ggx {
+            alpha_x: alpha_x.clamp(DELTA_ALPHA, 1.0),
+            alpha_y: alpha_y.clamp(DELTA_ALPHA, 1.0),
+            axis: Vec2::X,
+        })
+    }
+
+    /// The same distribution with its x axis turned to `axis` (a unit vector of the local
+    /// tangent plane).
+    pub fn turned(self, axis: Vec2) -> Ggx {
+        Ggx { axis, ..self }
+    }
+
+    /// The isotropic width with the same area of slopes, √(αx·αy): what tables of
+    /// isotropic GGX are read at (as Cycles reads its albedo tables).
+    pub fn mean_alpha(&self) -> f32 {
+        (self.alpha_x * self.alpha_y).sqrt()
+    }
+
+    /// `w` in the frame whose x is the axis.
+    fn aligned(&self, w: Vec3) -> Vec3 {
+        let (c, s) = (self.axis.x, self.axis.y);
+        Vec3::new(c * w.x + s * w.y, c * w.y - s * w.x, w.z)
+    }
+
+    /// `w` from the axis' frame back to the local frame.
+    fn unaligned(&self, w: Vec3) -> Vec3 {
+        let (c, s) = (self.axis.x, self.axis.y);
+        Vec3::new(c * w.x - s * w.y, s * w.x + c * w.y, w.z)
+    }
+
+    /// D(h): microfacet normals per unit projected area, per steradian,
+    /// 1/(π αx αy (hx²/αx² + hy²/αy² + hz²)²).
     pub fn d(&self, h: Vec3) -> f32 {
         if h.z <= 0.0 {
             return 0.0;
         }
-        let a2 = self.alpha * self.alpha;
-        let t = h.z * h.z * (a2 - 1.0) + 1.0;
-        a2 / (PI * t * t)
+        let h = self.aligned(h);
+        let (x, y) = (h.x / self.alpha_x, h.y / self.alpha_y);
+        let t = x * x + y * y + h.z * h.z;
+        1.0 / (PI * self.alpha_x * self.alpha_y * t * t)
     }
 
-    /// Smith's Λ(w) for GGX: G1 = 1/(1 + Λ).
+    /// Smith's Λ(w) for GGX: G1 = 1/(1 + Λ), with α² tan²θ taken along w's azimuth,
+    /// (αx² wx² + αy² wy²)/wz².
     pub fn lambda(&self, w: Vec3) -> f32 {
         let cos2 = w.z * w.z;
         if cos2 == 0.0 {
             return f32::INFINITY;
         }
-        let tan2 = (1.0 - cos2).max(0.0) / cos2;
-        0.5 * ((1.0 + self.alpha * self.alpha * tan2).sqrt() - 1.0)
+        let w = self.aligned(w);
+        let (x, y) = (self.alpha_x * w.x, self.alpha_y * w.y);
+        0.5 * ((1.0 + (x * x + y * y) / cos2).sqrt() - 1.0)
     }
 
     /// Masking of one direction.
@@ -71,13 +125,14 @@ impl Ggx {
     /// upper side): the stretched view direction plus a point on a spherical cap (Dupuy &
     /// Benyoub 2023, listing 3), unstretched.
     pub fn sample_visible(&self, w: Vec3, u: Vec2) -> Vec3 {
-        let w = if w.z < 0.0 { -w } else { w };
-        let stretched = Vec3::new(self.alpha * w.x, self.alpha * w.y, w.z).normalize();
+        let w = self.aligned(if w.z < 0.0 { -w } else { w });
+        let stretched = Vec3::new(self.alpha_x * w.x, self.alpha_y * w.y, w.z).normalize();
         let phi = TAU * u.x;
         let z = (1.0 - u.y) * (1.0 + stretched.z) - stretched.z;
         let sin = (1.0 - z * z).max(0.0).sqrt();
         let h = Vec3::new(sin * phi.cos(), sin * phi.sin(), z) + stretched;
-        Vec3::new(self.alpha * h.x, self.alpha * h.y, h.z.max(1e-7)).normalize()
+        let h = Vec3::new(self.alpha_x * h.x, self.alpha_y * h.y, h.z.max(1e-7)).normalize();
+        self.unaligned(h)
     }
 }
 
@@ -95,8 +150,13 @@ mod tests {
     /// integrate to 1 (Heitz 2014, eqs. 4 and 18): checked by uniform sphere sampling.
     #[test]
     fn distribution_and_visible_normals_are_normalised() {
-        for alpha in [0.05f32, 0.2, 0.5, 1.0] {
-            let ggx = Ggx { alpha };
+        let turned = Vec2::new(0.6, 0.8);
+        let cases = [0.05f32, 0.2, 0.5, 1.0]
+            .map(Ggx::isotropic)
+            .into_iter()
+            .chain([Ggx::anisotropic(0.1, 0.5).unwrap().turned(turned)]);
+        for ggx in cases {
+            let alpha = ggx.alpha_x.min(ggx.alpha_y);
             let wo = Vec3::new(0.6, 0.0, 0.8);
             let mut rng = Rng::new(1, 2);
             let n = 2_000_000;
@@ -114,11 +174,11 @@ mod tests {
             let tolerance = 0.01 + 0.002 / f64::from(alpha * alpha);
             assert!(
                 (projected - 1.0).abs() < tolerance,
-                "α {alpha}: ∫D cos = {projected}"
+                "{ggx:?}: ∫D cos = {projected}"
             );
             assert!(
                 (visible - 1.0).abs() < tolerance,
-                "α {alpha}: ∫D_wo = {visible}"
+                "{ggx:?}: ∫D_wo = {visible}"
             );
         }
     }
@@ -127,6 +187,31 @@ mod tests {
     fn sharp_roughness_is_a_delta() {
         assert!(Ggx::from_roughness(0.0).is_none());
         assert!(Ggx::from_roughness(0.03).is_none());
-        assert_eq!(Ggx::from_roughness(0.5).unwrap().alpha, 0.25);
+        assert_eq!(Ggx::from_roughness(0.5).unwrap().alpha_x, 0.25);
+        assert!(Ggx::anisotropic(1e-4, 2e-4).is_none());
+        assert_eq!(Ggx::anisotropic(1e-4, 0.3).unwrap().alpha_x, DELTA_ALPHA);
+    }
+
+    /// Turning the axis turns the distribution: D of a turned lobe at a turned normal is
+    /// D of the unturned one, and an isotropic lobe is the same whatever its axis.
+    #[test]
+    fn turning_the_axis_turns_the_distribution() {
+        let ggx = Ggx::anisotropic(0.1, 0.6).unwrap();
+        let angle = 0.7f32;
+        let turned = ggx.turned(Vec2::new(angle.cos(), angle.sin()));
+        let h = Vec3::new(0.3, 0.1, 0.9).normalize();
+        let rotated = Vec3::new(
+            h.x * angle.cos() - h.y * angle.sin(),
+            h.x * angle.sin() + h.y * angle.cos(),
+            h.z,
+        );
+        assert!((turned.d(rotated) - ggx.d(h)).abs() < 1e-4 * ggx.d(h));
+        assert!((turned.lambda(rotated) - ggx.lambda(h)).abs() < 1e-5);
+        let iso = Ggx::isotropic(0.3);
+        assert!((iso.turned(Vec2::new(0.6, 0.8)).d(h) - iso.d(h)).abs() < 1e-5);
+        // Wider along x: a normal tilted along x is likelier than one tilted along y.
+        let (along, across) = (Vec3::new(0.3, 0.0, 1.0), Vec3::new(0.0, 0.3, 1.0));
+        let wide = Ggx::anisotropic(0.5, 0.1).unwrap();
+        assert!(wide.d(along.normalize()) > wide.d(across.normalize()));
     }
 }

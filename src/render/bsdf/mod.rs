@@ -34,9 +34,10 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::sampling::{Frame, cosine_hemisphere};
-use crate::scene::{Pbr, f0_of_ior};
+use crate::scene::{Anisotropy, AnisotropyModel, Pbr, f0_of_ior};
 use fresnel::Fresnel;
 use glass::GlassLobe;
+use microfacet::Ggx;
 use sheen::charlie_brdf;
 use specular::SpecularLobe;
 
@@ -46,6 +47,26 @@ const COAT_IOR: f32 = 1.5;
 
 /// The index of refraction whose normal-incidence reflectance is `f0` < 1 (the inverse of
 /// [`f0_of_ior`]).
+/// The anisotropic GGX distribution of the metal and specular lobes, stretched along
+/// local x (turned to the surface's direction by [`Bsdf::with_tangent`]) by the
+/// anisotropy's model; `None` when they are isotropic. The inner `None` is a delta lobe.
+#[allow(clippy::option_option)]
+fn anisotropic_distribution(roughness: f32, anisotropy: &Anisotropy) -> Option<Option<Ggx>> {
+    let strength = anisotropy.strength.clamp(0.0, 1.0);
+    if strength == 0.0 {
+        return None;
+    }
+    let alpha = roughness * roughness;
+    let (along, across) = match anisotropy.model {
+        AnisotropyModel::Gltf => (alpha + (1.0 - alpha) * strength * strength, alpha),
+        AnisotropyModel::Cycles => {
+            let aspect = (1.0 - 0.9 * strength).sqrt();
+            (alpha / aspect, alpha * aspect)
+        }
+    };
+    Some(Ggx::anisotropic(along, across))
+}
+
 fn ior_of_f0(f0: f32) -> f32 {
     let r = f0.clamp(0.0, 0.99).sqrt();
     (1.0 + r) / (1.0 - r)
@@ -130,6 +151,10 @@ impl Bsdf {
         // F = F0·colour + (1 − F0·colour)·(F_η − F0)/(1 − F0). A specular colour of 0 keeps
         // that grazing rise; glTF's F0 = min(F0(ior)·colour, 1)·specular is the same at
         // normal incidence.
+        let glossy = |fresnel| match anisotropic_distribution(roughness, &pbr.anisotropy) {
+            Some(ggx) => SpecularLobe::anisotropic(ggx, fresnel),
+            None => SpecularLobe::new(roughness, fresnel),
+        };
         let f0 = (f0_of_ior(pbr.ior) * pbr.specular.clamp(0.0, 1.0)).min(0.99);
         let specular = positive(dielectric).filter(|_| f0 > 0.0).map(|w| {
             let tinted = (f0 * pbr.specular_colour.max(Vec3::ZERO)).min(Vec3::ONE);
@@ -139,11 +164,11 @@ impl Bsdf {
                 scale,
                 offset: tinted - scale * f0,
             };
-            (SpecularLobe::new(roughness, fresnel), w)
+            (glossy(fresnel), w)
         });
         let metal = positive(metallic).map(|w| {
             let fresnel = Fresnel::Schlick { f0: base, f90: 1.0 };
-            (SpecularLobe::new(roughness, fresnel), w)
+            (glossy(fresnel), w)
         });
         // Each crossing tints by √(base colour), as Cycles' Principled BSDF does
         // (`svm/closure.h`: the glass's transmission tint is sqrt(base colour)), so light
@@ -233,6 +258,19 @@ impl Bsdf {
         }
         let tan2 = 1.0 / (cos_i * cos_i) - 1.0;
         2.0 / (1.0 + (1.0 + alpha2 * tan2).sqrt())
+    }
+
+    /// Turns the metal and specular lobes' anisotropy to `tangent` (world space) around the
+    /// shading normal `n` the BSDF is evaluated with; isotropic lobes are unchanged.
+    pub fn with_tangent(mut self, n: Vec3, tangent: Vec3) -> Bsdf {
+        let local = Frame::from_normal(n).to_local(tangent);
+        let Some(axis) = Vec2::new(local.x, local.y).try_normalize() else {
+            return self;
+        };
+        for lobe in [&mut self.specular, &mut self.metal].into_iter().flatten() {
+            lobe.0 = lobe.0.turned(axis);
+        }
+        self
     }
 
     /// A direction of the glossy frame in the cosine lobes' frame.

@@ -38,7 +38,17 @@ pub struct SpecularLobe {
 impl SpecularLobe {
     /// The lobe of perceptual `roughness` with Fresnel factor `fresnel`.
     pub fn new(roughness: f32, fresnel: Fresnel) -> SpecularLobe {
-        let ggx = Ggx::from_roughness(roughness);
+        SpecularLobe::with_ggx(Ggx::from_roughness(roughness), roughness, fresnel)
+    }
+
+    /// The lobe of an anisotropic distribution; it reads the isotropic albedo tables at
+    /// its mean width (as Cycles does).
+    pub fn anisotropic(ggx: Option<Ggx>, fresnel: Fresnel) -> SpecularLobe {
+        let roughness = ggx.map_or(0.0, |g| g.mean_alpha().sqrt());
+        SpecularLobe::with_ggx(ggx, roughness, fresnel)
+    }
+
+    fn with_ggx(ggx: Option<Ggx>, roughness: f32, fresnel: Fresnel) -> SpecularLobe {
         let multiple = if ggx.is_some() {
             let average = match fresnel {
                 Fresnel::Schlick { f0, f90 } => schlick_average(f0, f90),
@@ -56,6 +66,15 @@ impl SpecularLobe {
             roughness,
             fresnel,
             multiple,
+        }
+    }
+
+    /// The same lobe with its anisotropy axis turned to `axis` (a unit vector of the local
+    /// tangent plane).
+    pub fn turned(self, axis: Vec2) -> SpecularLobe {
+        SpecularLobe {
+            ggx: self.ggx.map(|g| g.turned(axis)),
+            ..self
         }
     }
 

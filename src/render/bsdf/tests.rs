@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 
 use super::Bsdf;
 use crate::render::sampling::Rng;
-use crate::scene::Pbr;
+use crate::scene::{Anisotropy, AnisotropyModel, Pbr};
 
 fn direction(mu: f32) -> Vec3 {
     Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu)
@@ -128,6 +128,25 @@ fn sampling_matches_pdf_chi_square() {
         Bsdf::new(&Pbr::diffuse(Vec3::splat(0.5)), true).with_diffuse_normal(Vec3::Z, away),
         true,
     ));
+    // Anisotropic metal and plastic, stretched along a direction 40° from wo's azimuth,
+    // by both models.
+    let turned = Vec3::new(40f32.to_radians().cos(), 40f32.to_radians().sin(), 0.0);
+    for (name, model) in [
+        ("anisotropic, glTF", AnisotropyModel::Gltf),
+        ("anisotropic, Cycles", AnisotropyModel::Cycles),
+    ] {
+        for base in [materials()[1].1, materials()[3].1] {
+            let pbr = Pbr {
+                anisotropy: Anisotropy {
+                    strength: 0.8,
+                    rotation: 0.0,
+                    model,
+                },
+                ..base
+            };
+            cases.push((name, Bsdf::new(&pbr, true).with_tangent(Vec3::Z, turned), true));
+        }
+    }
     for (name, bsdf, front) in cases {
         for mu in [0.15f32, 0.6, 0.95] {
             let wo = direction(mu);
