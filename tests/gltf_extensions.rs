@@ -1,7 +1,8 @@
 //! glTF extensions and storage forms read by hand-built files whose answers are known:
 //! quantised attributes (`KHR_mesh_quantization`), sparse accessors without a bufferView,
 //! `EXT_mesh_gpu_instancing`, `KHR_materials_unlit`,
-//! `KHR_materials_pbrSpecularGlossiness` and `KHR_materials_variants`.
+//! `KHR_materials_pbrSpecularGlossiness`, `KHR_materials_variants` and
+//! `KHR_materials_anisotropy`.
 
 #[path = "support/binary/mod.rs"]
 mod binary;
@@ -14,6 +15,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
 use gridtrace::load::{LoadOptions, load_scene, load_scene_with};
+use gridtrace::scene::AnisotropyModel;
 use serde_json::{Value, json};
 
 /// Writes `document` with `buffer` as its only buffer, in a base64 data URI, and checks it
@@ -26,7 +28,11 @@ fn write(dir: &Path, name: &str, buffer: &[u8], document: Value) -> PathBuf {
 
 /// [`write`] without the validator, for a file that breaks the specification on purpose.
 fn write_unchecked(dir: &Path, name: &str, buffer: &[u8], mut document: Value) -> PathBuf {
+    let generator = document["asset"]["generator"].take();
     document["asset"] = json!({"version": "2.0"});
+    if generator.is_string() {
+        document["asset"]["generator"] = generator;
+    }
     document["buffers"] = json!([{
         "uri": format!("data:application/octet-stream;base64,{}", base64::encode(buffer)),
         "byteLength": buffer.len()
@@ -397,4 +403,55 @@ fn material_variants_choose_each_primitives_material() {
         error.contains("pygltflib_variants.gltf") && error.contains("0 'Blue', 1 'Green'"),
         "{error}"
     );
+}
+
+/// `KHR_materials_anisotropy` follows the writer: a file Blender's exporter wrote (its
+/// `asset.generator`) means Blender's Anisotropic, stretched as Cycles stretches it; any
+/// other file means the extension's own model. Strength, rotation and texture are read, and
+/// tangents are made for the anisotropic surface.
+#[test]
+fn anisotropy_is_read_and_its_model_follows_the_writer() {
+    let material = json!({
+        "pbrMetallicRoughness": {"metallicFactor": 1.0, "roughnessFactor": 0.3},
+        "extensions": {"KHR_materials_anisotropy": {
+            "anisotropyStrength": 0.7, "anisotropyRotation": 0.5
+        }}
+    });
+    let dir = tempfile::tempdir().unwrap();
+    for (generator, model) in [
+        ("Khronos glTF Blender I/O v5.0.21", AnisotropyModel::Cycles),
+        ("glTF-Transform v4.1.0", AnisotropyModel::Gltf),
+    ] {
+        let (buffer, mut document) =
+            quad_facing_camera(material.clone(), "KHR_materials_anisotropy");
+        let mut primitive = document["meshes"][0]["primitives"][0].take();
+        primitive["attributes"]["NORMAL"] = json!(2);
+        primitive["attributes"]["TEXCOORD_0"] = json!(3);
+        document["meshes"][0]["primitives"][0] = primitive;
+        let mut buffer = buffer;
+        let normals_at = buffer.len();
+        buffer.extend(f32s(&[0.0, 0.0, 1.0].repeat(4)));
+        let uvs_at = buffer.len();
+        buffer.extend(f32s(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]));
+        let views = document["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({"buffer": 0, "byteOffset": normals_at, "byteLength": 48}));
+        views.push(json!({"buffer": 0, "byteOffset": uvs_at, "byteLength": 32}));
+        let accessors = document["accessors"].as_array_mut().unwrap();
+        accessors.push(json!({"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3"}));
+        accessors.push(json!({"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC2"}));
+        document["asset"] = json!({"generator": generator});
+        let path = write(dir.path(), "a.gltf", &buffer, document);
+        let loaded = load_scene(&path).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        let scene = loaded.scene;
+        let m = &scene.materials[scene.meshes[0].material];
+        assert_eq!(m.pbr.anisotropy.model, model, "{generator}");
+        assert!((m.pbr.anisotropy.strength - 0.7).abs() < 1e-6);
+        assert!((m.pbr.anisotropy.rotation - 0.5).abs() < 1e-6);
+        let mesh = &scene.meshes[0];
+        assert!(
+            !mesh.tangents.is_empty() && mesh.tangents.len() == mesh.positions.len(),
+            "tangents for the anisotropic surface"
+        );
+    }
 }

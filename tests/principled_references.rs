@@ -107,3 +107,12 @@ fn specular_tints_match_cycles() {
 fn udim_tiles_from_usd_match_cycles() {
     check("principled_udim", "usdc", SPP);
 }
+
+/// Brushed metal (Anisotropic 0.8 along the UV tangent, and turned a quarter turn) and a
+/// brushed plastic (0.6), through Blender's glTF export (`KHR_materials_anisotropy`; a file
+/// Blender wrote stretches its lobes as Cycles does). Blender's USD export writes no
+/// anisotropy into its preview surface, so only the .glb is compared.
+#[test]
+fn anisotropic_metal_and_plastic_match_cycles() {
+    check("principled_anisotropy", "glb", SPP);
+}

@@ -157,6 +157,15 @@ fn material_summary(m: &Material, emitted: f32) -> String {
             significant(p.sheen_roughness)
         );
     }
+    if p.anisotropy.strength > 0.0 {
+        let _ = write!(
+            s,
+            ", anisotropy {} at {}° ({:?})",
+            significant(p.anisotropy.strength),
+            significant(p.anisotropy.rotation.to_degrees()),
+            p.anisotropy.model
+        );
+    }
     if m.is_emissive() {
         let _ = write!(
             s,

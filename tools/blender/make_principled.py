@@ -23,6 +23,9 @@ clamping, no denoising, 64 bounces, black world).
 - principled_normals: floor panels normal-mapped 15° and 45° away from the camera, and a
   coarse smooth-shaded metal ball.
 - principled_specular: dark plastic spheres with a black, a red and a white Specular Tint.
+- principled_anisotropy: brushed metal balls (Anisotropic 0.8, roughness 0.3) stretched
+  along their UV tangent and turned a quarter turn, and a brushed plastic (0.6); the
+  Principled Tangent input is a UV Tangent node, the frame glTF's tangents give.
 - principled_udim: four panels whose colour is a UDIM image of three tiles (1001, 1002,
   1011), each a gradient of its own hue, darker towards its bottom; each panel shows one tile.
   The glTF exporter splits UDIM images into one material and image per tile; the USD exporter
@@ -206,6 +209,23 @@ def build_normals(scene):
     ball.data.materials.append(blender_default("CoarseMetal", (0.9, 0.9, 0.92), Metallic=1.0, Roughness=0.3))
 
 
+def build_anisotropy(scene):
+    room(scene)
+    for name, colour, metallic, rotation, x in (
+            ("BrushedSteel", (0.8, 0.8, 0.82), 1.0, 0.0, -1.1),
+            ("TurnedGold", (1.0, 0.78, 0.34), 1.0, 0.25, 0.0),
+            ("BrushedPlastic", (0.6, 0.1, 0.1), 0.0, 0.0, 1.1)):
+        mat = blender_default(name, colour, Metallic=metallic, Roughness=0.3,
+                              Anisotropic=0.8 if metallic else 0.6,
+                              **{"Anisotropic Rotation": rotation})
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        tangent = nodes.new("ShaderNodeTangent")
+        tangent.direction_type = "UV_MAP"
+        tangent.uv_map = "UVMap"
+        links.new(tangent.outputs["Tangent"], nodes["Principled BSDF"].inputs["Tangent"])
+        sphere(name, mat, 0.5, (x, 0.0, 0.5))
+
+
 def build_udim(scene):
     """A panel whose UVs span tiles 1001, 1002 (s 1–2) and 1011 (t 1–2) of a UDIM image.
     The tiles are written as PNG files first and loaded as one tiled image, as a user's
@@ -263,6 +283,7 @@ SCENE_TABLE = {
     "principled_normals": (build_normals, 2048),
     "principled_specular": (build_specular, 2048),
     "principled_udim": (build_udim, 1024),
+    "principled_anisotropy": (build_anisotropy, 2048),
 }
 # Glass reaches USD only through the exporter's MaterialX network.
 MATERIALX = {"principled_glass", "principled_glass_tints"}

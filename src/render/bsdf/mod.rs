@@ -5,7 +5,8 @@
 //! ```text
 //! coat  ─ clear GGX dielectric (index 1.5, exact Fresnel × clearcoat)
 //!  └ sheen ─ Charlie sheen
-//!     └ metallic · GGX conductor (F0 = base colour)
+//!     └ metallic · GGX conductor (F0 = base colour; anisotropic along the tangent
+//!                  frame where the material says so, as is the dielectric layer)
 //!       + (1 − metallic)(1 − transmission) · [GGX dielectric layer over Lambertian base]
 //!       + (1 − metallic) · transmission · rough or smooth glass (√base colour per crossing)
 //! ```

@@ -144,7 +144,11 @@ fn sampling_matches_pdf_chi_square() {
                 },
                 ..base
             };
-            cases.push((name, Bsdf::new(&pbr, true).with_tangent(Vec3::Z, turned), true));
+            cases.push((
+                name,
+                Bsdf::new(&pbr, true).with_tangent(Vec3::Z, turned),
+                true,
+            ));
         }
     }
     for (name, bsdf, front) in cases {
