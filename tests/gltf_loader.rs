@@ -224,11 +224,11 @@ fn materials_map_by_the_table() {
 fn unsupported_required_extensions_are_errors_and_used_ones_warnings() {
     let dir = tempfile::tempdir().unwrap();
     let mut doc = quad_document();
-    doc["extensionsUsed"] = json!(["EXT_fancy_thing", "KHR_materials_anisotropy"]);
+    doc["extensionsUsed"] = json!(["EXT_fancy_thing", "KHR_materials_iridescence"]);
     let loaded = load_scene(&write_gltf(dir.path(), "w.gltf", &doc)).unwrap();
     assert_eq!(loaded.warnings.len(), 1);
     assert!(
-        loaded.warnings[0].contains("EXT_fancy_thing, KHR_materials_anisotropy"),
+        loaded.warnings[0].contains("EXT_fancy_thing, KHR_materials_iridescence"),
         "{:?}",
         loaded.warnings
     );
