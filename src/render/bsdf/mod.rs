@@ -46,16 +46,13 @@ use specular::SpecularLobe;
 /// Cycles' coat defaults.
 const COAT_IOR: f32 = 1.5;
 
-/// The index of refraction whose normal-incidence reflectance is `f0` < 1 (the inverse of
-/// [`f0_of_ior`]).
-/// The anisotropic GGX distribution of the metal and specular lobes, stretched along
-/// local x (turned to the surface's direction by [`Bsdf::with_tangent`]) by the
-/// anisotropy's model; `None` when they are isotropic. The inner `None` is a delta lobe.
-#[allow(clippy::option_option)]
-fn anisotropic_distribution(roughness: f32, anisotropy: &Anisotropy) -> Option<Option<Ggx>> {
+/// The metal or specular lobe with Fresnel factor `fresnel`: isotropic GGX at `roughness`,
+/// or anisotropic GGX stretched along local x (turned to the surface's direction by
+/// [`Bsdf::with_tangent`]) by the anisotropy's model.
+fn glossy_lobe(roughness: f32, anisotropy: &Anisotropy, fresnel: Fresnel) -> SpecularLobe {
     let strength = anisotropy.strength.clamp(0.0, 1.0);
     if strength == 0.0 {
-        return None;
+        return SpecularLobe::new(roughness, fresnel);
     }
     let alpha = roughness * roughness;
     let (along, across) = match anisotropy.model {
@@ -65,9 +62,11 @@ fn anisotropic_distribution(roughness: f32, anisotropy: &Anisotropy) -> Option<O
             (alpha / aspect, alpha * aspect)
         }
     };
-    Some(Ggx::anisotropic(along, across))
+    SpecularLobe::anisotropic(Ggx::anisotropic(along, across), fresnel)
 }
 
+/// The index of refraction whose normal-incidence reflectance is `f0` < 1 (the inverse of
+/// [`f0_of_ior`]).
 fn ior_of_f0(f0: f32) -> f32 {
     let r = f0.clamp(0.0, 0.99).sqrt();
     (1.0 + r) / (1.0 - r)
@@ -152,10 +151,7 @@ impl Bsdf {
         // F = F0·colour + (1 − F0·colour)·(F_η − F0)/(1 − F0). A specular colour of 0 keeps
         // that grazing rise; glTF's F0 = min(F0(ior)·colour, 1)·specular is the same at
         // normal incidence.
-        let glossy = |fresnel| match anisotropic_distribution(roughness, &pbr.anisotropy) {
-            Some(ggx) => SpecularLobe::anisotropic(ggx, fresnel),
-            None => SpecularLobe::new(roughness, fresnel),
-        };
+        let glossy = |fresnel| glossy_lobe(roughness, &pbr.anisotropy, fresnel);
         let f0 = (f0_of_ior(pbr.ior) * pbr.specular.clamp(0.0, 1.0)).min(0.99);
         let specular = positive(dielectric).filter(|_| f0 > 0.0).map(|w| {
             let tinted = (f0 * pbr.specular_colour.max(Vec3::ZERO)).min(Vec3::ONE);
