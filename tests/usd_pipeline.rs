@@ -374,13 +374,21 @@ fn blender_glass_from_usd_with_materialx_is_the_gltf_glass() {
 /// 1.2 × 10⁻⁷ m, float precision — the limit positions are Blender's). On a
 /// grid with an open boundary the points beside its corners were measured 1.6 mm off (the
 /// limit mask used assumes interior neighbours; OpenSubdiv evaluates boundary patches), so
-/// that object is held to 2 mm, a bound set after that measurement.
+/// that object is held to 2 mm, a bound set after that measurement. A cube with Blender's
+/// creases — edges creased 1 round its top face (sharpness 10, infinite), one vertical
+/// edge 0.5 (sharpness 2.5, still semi-sharp after two levels) and one vertex 1 — is held
+/// to 1 mm too (measured: 1.8 × 10⁻⁷ m).
 #[test]
 fn blender_subdivision_cage_refines_to_blenders_own_surface() {
     let cage = load_clean(&Path::new(DIR).join("subdivision_cage.usda"));
     let applied = load_clean(&Path::new(DIR).join("subdivision_applied.usda"));
-    for (object, tolerance) in [("Cube", 1e-3), ("Cylinder", 1e-3), ("Grid", 2e-3)] {
-        let prim = format!("/root/{object}/{object}");
+    for (object, mesh, tolerance) in [
+        ("Cube", "Cube", 1e-3),
+        ("Cylinder", "Cylinder", 1e-3),
+        ("Grid", "Grid", 2e-3),
+        ("CreasedCube", "Cube_001", 1e-3),
+    ] {
+        let prim = format!("/root/{object}/{mesh}");
         let ours = mesh_points(&cage.scene, &prim);
         let blender = mesh_points(&applied.scene, &prim);
         assert!(!ours.is_empty() && !blender.is_empty(), "{prim}");
@@ -506,6 +514,69 @@ def Mesh "Quad"
             assert!(tetra.positions.iter().all(|p| p.abs().max_element() < 1.0));
         }
     }
+}
+
+/// Crease data that does not fit its mesh is left out with a warning naming the mesh and
+/// what is wrong, and the surface refines smooth there: an index outside the points,
+/// lengths that do not add up, a sharpness count that fits neither creases nor edges, and
+/// corner sharpnesses missing. A sharpness that is not a number counts as smooth; creases
+/// on a Loop surface are named as not applied.
+#[test]
+fn malformed_creases_are_left_out_with_a_warning() {
+    let quad = |name: &str, creases: &str| {
+        format!(
+            r#"def Mesh "{name}"
+{{
+    int[] faceVertexCounts = [4, 4]
+    int[] faceVertexIndices = [0, 1, 2, 3, 1, 4, 5, 2]
+    point3f[] points = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (2, 0, 0), (2, 1, 0)]
+    uniform token subdivisionScheme = "catmullClark"
+    {creases}
+}}
+"#
+        )
+    };
+    let cases = [
+        (
+            "Outside",
+            "int[] creaseIndices = [1, 9]\n int[] creaseLengths = [2]\n float[] creaseSharpnesses = [3]",
+            "point index 9 is outside the 6 points",
+        ),
+        (
+            "Lengths",
+            "int[] creaseIndices = [1, 2]\n int[] creaseLengths = [3]\n float[] creaseSharpnesses = [3]",
+            "creaseLengths add up to 3",
+        ),
+        (
+            "Count",
+            "int[] creaseIndices = [0, 1, 2]\n int[] creaseLengths = [3]\n float[] creaseSharpnesses = [1, 2, 3]",
+            "3 creaseSharpnesses for 1 creases of 2 edges",
+        ),
+        (
+            "Corners",
+            "int[] cornerIndices = [0, 4]\n float[] cornerSharpnesses = [10]",
+            "1 cornerSharpnesses for 2 cornerIndices",
+        ),
+    ];
+    let stage: String = cases
+        .iter()
+        .map(|(name, creases, _)| quad(name, creases))
+        .chain([quad("NotANumber", "int[] creaseIndices = [1, 2]\n int[] creaseLengths = [2]\n float[] creaseSharpnesses = [nan]")])
+        .collect();
+    let (_dir, path) = write_stage(&stage);
+    let loaded = load_scene(&path).unwrap();
+    for (name, _, why) in cases {
+        assert!(
+            loaded
+                .warnings
+                .iter()
+                .any(|w| w.contains(&format!("/{name}: ")) && w.contains(why)),
+            "{name}: {:#?}",
+            loaded.warnings
+        );
+    }
+    assert_eq!(loaded.warnings.len(), cases.len(), "{:#?}", loaded.warnings);
+    assert_eq!(loaded.scene.meshes.len(), cases.len() + 1);
 }
 
 /// The same two exports rendered (default camera and studio light, 64 samples per pixel in

@@ -484,17 +484,11 @@ impl UsdLoader {
                 levels
             }
         };
-        for crease in ["creaseIndices", "cornerIndices"] {
-            if self
-                .get(path, crease)
-                .as_ref()
-                .and_then(as_ints)
-                .is_some_and(|c| !c.is_empty())
-            {
-                self.warn(format!(
-                    "{where_}: {crease} are not applied; the surface is smooth there"
-                ));
-            }
+        let sharpness = self.creases(path, polygons.points.len());
+        if is_loop && !sharpness.is_empty() {
+            self.warn(format!(
+                "{where_}: creases are not applied to a Loop surface; it is smooth there"
+            ));
         }
         let boundary = match self.get_token(path, "interpolateBoundary").as_deref() {
             Some("edgeOnly") => Boundary::EdgeOnly,
@@ -517,6 +511,7 @@ impl UsdLoader {
             indices: polygons.indices.clone(),
             uvs,
             origin: (0..polygons.counts.len()).collect(),
+            sharpness,
         };
         let refined = if is_loop {
             loop_subdivision(&cage, boundary, levels)

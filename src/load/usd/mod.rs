@@ -15,6 +15,7 @@ use glam::{Mat4, Vec3};
 use openusd::{sdf, usd};
 
 mod camera;
+mod crease;
 mod implicit;
 mod instancer;
 mod light;

@@ -2,13 +2,17 @@
 //! of a triangle cage (Loop 1987, with his β weights), with boundaries as OpenSubdiv and
 //! USD's `interpolateBoundary` define them, and the refined points moved to their limit
 //! positions (Catmull–Clark: Halstead, Kass & DeRose 1993, §3; Loop: Loop 1987, §3.3), as
-//! Blender's Subdivision modifier does with "Use Limit Surface" (its default). Face-varying
-//! data (texture coordinates) is interpolated linearly within each face; creases are not
-//! applied.
+//! Blender's Subdivision modifier does with "Use Limit Surface" (its default). Catmull–Clark
+//! surfaces take semi-sharp edge and vertex creases ([`crease`]); Loop surfaces are smooth.
+//! Face-varying data (texture coordinates) is interpolated linearly within each face.
+
+mod crease;
 
 use std::collections::HashMap;
 
 use glam::{Vec2, Vec3};
+
+pub use crease::{INFINITE as INFINITE_SHARPNESS, Sharpness};
 
 /// A polygon mesh to refine: faces as corner counts and point indices, optional texture
 /// coordinates per face corner, and for each face the cage face it came from.
@@ -24,6 +28,8 @@ pub struct Cage {
     pub uvs: Option<Vec<Vec2>>,
     /// The cage face each face came from.
     pub origin: Vec<usize>,
+    /// Creased edges and vertices (Catmull–Clark only).
+    pub sharpness: Sharpness,
 }
 
 /// How boundary edges and corners refine (USD `interpolateBoundary`).
@@ -53,7 +59,9 @@ pub fn catmull_clark(cage: &Cage, boundary: Boundary, levels: u32) -> Cage {
         mesh = refine(&mesh, boundary);
     }
     if levels > 0 {
-        mesh.points = limit_positions(&mesh, boundary);
+        let mut limits = limit_positions(&mesh, boundary);
+        crease::semi_sharp_limits(&mesh, boundary, &mut limits);
+        mesh.points = limits;
     }
     mesh
 }
@@ -209,6 +217,8 @@ struct Edges {
     faces: Vec<Vec<usize>>,
     /// Edge from corner i to corner i + 1 of its face.
     of_corner: Vec<usize>,
+    /// Edge of each point pair, smaller index first.
+    index: HashMap<(usize, usize), usize>,
 }
 
 fn edges(mesh: &Cage) -> Edges {
@@ -238,6 +248,7 @@ fn edges(mesh: &Cage) -> Edges {
         ends,
         faces,
         of_corner,
+        index,
     }
 }
 
@@ -260,16 +271,17 @@ fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
             c.iter().map(|&v| mesh.points[v]).sum::<Vec3>() / c.len().max(1) as f32
         })
         .collect();
-    let is_boundary = |e: usize| edges.faces[e].len() != 2;
+    let sharpness = edge_sharpness(mesh, &edges);
     let edge_points: Vec<Vec3> = (0..edges.ends.len())
         .map(|e| {
             let [a, b] = edges.ends[e];
             let mid = 0.5 * (mesh.points[a] + mesh.points[b]);
-            if is_boundary(e) {
+            if sharpness[e] >= 1.0 {
                 mid
             } else {
                 let [f, g] = [edges.faces[e][0], edges.faces[e][1]];
-                0.5 * mid + 0.25 * (face_points[f] + face_points[g])
+                let smooth = 0.5 * mid + 0.25 * (face_points[f] + face_points[g]);
+                crease::edge_point(smooth, mid, sharpness[e])
             }
         })
         .collect();
@@ -286,7 +298,7 @@ fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
         vertex_edges[*a].push(e);
         vertex_edges[*b].push(e);
     }
-    let (_, border, faces) = neighbours(mesh, &edges);
+    let corners_sharpness = vertex_sharpness(mesh, &edges, boundary);
     let vertex_points: Vec<Vec3> = (0..n)
         .map(|v| {
             let p = mesh.points[v];
@@ -294,29 +306,22 @@ fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
             if incident.is_empty() {
                 return p;
             }
-            if !border[v].is_empty() {
-                return boundary_rule(
-                    &mesh.points,
-                    v,
-                    &border[v],
-                    faces[v],
-                    boundary,
-                    (0.125, 0.75),
-                )
-                .unwrap_or(p);
-            }
-            let valence = incident.len() as f32;
-            let f = vertex_faces[v]
-                .iter()
-                .map(|&f| face_points[f])
-                .sum::<Vec3>()
-                / vertex_faces[v].len() as f32;
-            let r = incident
-                .iter()
-                .map(|&e| 0.5 * (mesh.points[edges.ends[e][0]] + mesh.points[edges.ends[e][1]]))
-                .sum::<Vec3>()
-                / valence;
-            (f + 2.0 * r + (valence - 3.0) * p) / valence
+            let smooth = || {
+                let valence = incident.len() as f32;
+                let f = vertex_faces[v]
+                    .iter()
+                    .map(|&f| face_points[f])
+                    .sum::<Vec3>()
+                    / vertex_faces[v].len() as f32;
+                let r = incident
+                    .iter()
+                    .map(|&e| 0.5 * (mesh.points[edges.ends[e][0]] + mesh.points[edges.ends[e][1]]))
+                    .sum::<Vec3>()
+                    / valence;
+                (f + 2.0 * r + (valence - 3.0) * p) / valence
+            };
+            let around = incident_sharpness(mesh, &edges, &sharpness, incident, v);
+            crease::vertex_point(p, corners_sharpness[v], &around, smooth)
         })
         .collect();
 
@@ -328,6 +333,9 @@ fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
     let mut refined = Cage {
         points,
         uvs: mesh.uvs.as_ref().map(|_| Vec::new()),
+        sharpness: crease::refine(&mesh.sharpness, |a, b| {
+            edge_base + edges.index[&(a.min(b), a.max(b))]
+        }),
         ..Cage::default()
     };
     for (f, (&count, &start)) in mesh.counts.iter().zip(&starts).enumerate() {
@@ -366,7 +374,14 @@ fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
 /// B-spline's `(e₀ + 4 p + e₁) / 6`; corners stay.
 fn limit_positions(mesh: &Cage, boundary: Boundary) -> Vec<Vec3> {
     let edges = edges(mesh);
-    let (ring, border, faces) = neighbours(mesh, &edges);
+    let (ring, _, _) = neighbours(mesh, &edges);
+    let sharpness = edge_sharpness(mesh, &edges);
+    let corners_sharpness = vertex_sharpness(mesh, &edges, boundary);
+    let mut vertex_edges = vec![Vec::new(); mesh.points.len()];
+    for (e, [a, b]) in edges.ends.iter().enumerate() {
+        vertex_edges[*a].push(e);
+        vertex_edges[*b].push(e);
+    }
     let p = &mesh.points;
     let mut diagonal_sum = vec![Vec3::ZERO; p.len()];
     for quad in mesh.indices.chunks(4) {
@@ -379,13 +394,63 @@ fn limit_positions(mesh: &Cage, boundary: Boundary) -> Vec<Vec3> {
             if ring[v].is_empty() {
                 return p[v];
             }
-            if !border[v].is_empty() {
-                return boundary_rule(p, v, &border[v], faces[v], boundary, (1.0 / 6.0, 4.0 / 6.0))
-                    .unwrap_or(p[v]);
+            let smooth = || {
+                let k = ring[v].len() as f32;
+                let edge_sum: Vec3 = ring[v].iter().map(|&u| p[u]).sum();
+                (k * k * p[v] + 4.0 * edge_sum + diagonal_sum[v]) / (k * (k + 5.0))
+            };
+            let around = incident_sharpness(mesh, &edges, &sharpness, &vertex_edges[v], v);
+            crease::limit_point(p[v], corners_sharpness[v], &around, smooth)
+        })
+        .collect()
+}
+
+/// Each edge's sharpness: infinite on the boundary (an edge of one face, or of more than
+/// two), else its crease's.
+fn edge_sharpness(mesh: &Cage, edges: &Edges) -> Vec<f32> {
+    (0..edges.ends.len())
+        .map(|e| {
+            let [a, b] = edges.ends[e];
+            if edges.faces[e].len() != 2 {
+                crease::INFINITE
+            } else {
+                mesh.sharpness.edge(a, b)
             }
-            let k = ring[v].len() as f32;
-            let edge_sum: Vec3 = ring[v].iter().map(|&u| p[u]).sum();
-            (k * k * p[v] + 4.0 * edge_sum + diagonal_sum[v]) / (k * (k + 5.0))
+        })
+        .collect()
+}
+
+/// Each point's vertex sharpness: its corner crease's, or infinite where the boundary pins
+/// it — a point on a single face under `EdgeAndCorner`, or a non-manifold point (not two
+/// boundary edges).
+fn vertex_sharpness(mesh: &Cage, edges: &Edges, boundary: Boundary) -> Vec<f32> {
+    let (_, border, faces) = neighbours(mesh, edges);
+    (0..mesh.points.len())
+        .map(|v| {
+            let pinned = !border[v].is_empty()
+                && (border[v].len() != 2 || (faces[v] == 1 && boundary == Boundary::EdgeAndCorner));
+            if pinned {
+                crease::INFINITE
+            } else {
+                mesh.sharpness.point(v)
+            }
+        })
+        .collect()
+}
+
+/// The edges `incident` to point `v` as (other end's position, sharpness).
+fn incident_sharpness(
+    mesh: &Cage,
+    edges: &Edges,
+    sharpness: &[f32],
+    incident: &[usize],
+    v: usize,
+) -> Vec<(Vec3, f32)> {
+    incident
+        .iter()
+        .map(|&e| {
+            let [a, b] = edges.ends[e];
+            (mesh.points[if a == v { b } else { a }], sharpness[e])
         })
         .collect()
 }
@@ -415,6 +480,7 @@ mod tests {
             indices: faces.concat(),
             uvs: None,
             origin: (0..6).collect(),
+            sharpness: Sharpness::default(),
         }
     }
 
@@ -447,6 +513,48 @@ mod tests {
         }
     }
 
+    /// A cube whose every edge is infinitely sharp stays a cube: each face refines flat
+    /// between straight creases.
+    #[test]
+    fn a_cube_with_sharp_edges_stays_a_cube() {
+        let mut cage = cube();
+        for face in cage.indices.clone().chunks(4) {
+            for i in 0..4 {
+                let (a, b) = (face[i], face[(i + 1) % 4]);
+                cage.sharpness
+                    .edges
+                    .insert((a.min(b), a.max(b)), INFINITE_SHARPNESS);
+            }
+        }
+        let refined = catmull_clark(&cage, Boundary::EdgeAndCorner, 3);
+        for p in &refined.points {
+            assert!((p.abs().max_element() - 1.0).abs() < 1e-6, "{p}");
+        }
+    }
+
+    /// Where a semi-sharp crease outlives the levels refined, a point's limit is the limit
+    /// of the same point refined until the crease has decayed: sharpness 2.5 on every
+    /// edge and 1.5 at one corner, limits at level 1 against level 4.
+    #[test]
+    fn semi_sharp_limits_are_those_of_deeper_refinement() {
+        let mut cage = cube();
+        for face in cage.indices.clone().chunks(4) {
+            for i in 0..4 {
+                let (a, b) = (face[i], face[(i + 1) % 4]);
+                cage.sharpness.edges.insert((a.min(b), a.max(b)), 2.5);
+            }
+        }
+        cage.sharpness.points.insert(0, 1.5);
+        let shallow = catmull_clark(&cage, Boundary::EdgeAndCorner, 1);
+        let deep = catmull_clark(&cage, Boundary::EdgeAndCorner, 4);
+        for (v, p) in shallow.points.iter().enumerate() {
+            assert!(p.abs_diff_eq(deep.points[v], 1e-5), "{v}: {p} vs {}", deep.points[v]);
+        }
+        // And the creases mattered: the smooth cube's limit is elsewhere.
+        let smooth = catmull_clark(&cube(), Boundary::EdgeAndCorner, 1);
+        assert!(smooth.points[0].distance(shallow.points[0]) > 0.1);
+    }
+
     /// An open grid's boundary stays a B-spline of its boundary points, its corners fixed.
     #[test]
     fn an_open_quad_keeps_its_corners_with_edge_and_corner() {
@@ -456,6 +564,7 @@ mod tests {
             indices: vec![0, 1, 2, 3],
             uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y]),
             origin: vec![0],
+            sharpness: Sharpness::default(),
         };
         let refined = catmull_clark(&quad, Boundary::EdgeAndCorner, 2);
         for corner in &quad.points {
@@ -516,6 +625,7 @@ mod tests {
             indices: faces.concat(),
             uvs: None,
             origin: (0..20).collect(),
+            sharpness: Sharpness::default(),
         }
     }
 
@@ -557,6 +667,7 @@ mod tests {
                 Vec2::Y,
             ]),
             origin: vec![0, 1],
+            sharpness: Sharpness::default(),
         };
         let refined = loop_subdivision(&square, Boundary::EdgeAndCorner, 2);
         assert_eq!(refined.counts.len(), 32);
