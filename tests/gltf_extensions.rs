@@ -1,8 +1,8 @@
 //! glTF extensions and storage forms read by hand-built files whose answers are known:
 //! quantised attributes (`KHR_mesh_quantization`), sparse accessors without a bufferView,
 //! `EXT_mesh_gpu_instancing`, `KHR_materials_unlit`,
-//! `KHR_materials_pbrSpecularGlossiness`, `KHR_materials_variants` and
-//! `KHR_materials_anisotropy`.
+//! `KHR_materials_pbrSpecularGlossiness`, `KHR_materials_variants`,
+//! `KHR_materials_anisotropy`, and which sheen `KHR_materials_sheen` means.
 
 #[path = "support/binary/mod.rs"]
 mod binary;
@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
 use gridtrace::load::{LoadOptions, load_scene, load_scene_with};
-use gridtrace::scene::AnisotropyModel;
+use gridtrace::scene::{AnisotropyModel, SheenModel};
 use serde_json::{Value, json};
 
 /// Writes `document` with `buffer` as its only buffer, in a base64 data URI, and checks it
@@ -453,5 +453,33 @@ fn anisotropy_is_read_and_its_model_follows_the_writer() {
             !mesh.tangents.is_empty() && mesh.tangents.len() == mesh.positions.len(),
             "tangents for the anisotropic surface"
         );
+    }
+}
+
+/// `KHR_materials_sheen` follows the writer too: Blender's exporter writes the Principled
+/// BSDF's sheen, which is Cycles' microfibre layer; any other file means the extension's
+/// Charlie sheen.
+#[test]
+fn sheen_model_follows_the_writer() {
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.3, 0.02, 0.05, 1.0], "metallicFactor": 0.0},
+        "extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [1.0, 0.9, 0.8], "sheenRoughnessFactor": 0.5
+        }}
+    });
+    let dir = tempfile::tempdir().unwrap();
+    for (generator, model) in [
+        ("Khronos glTF Blender I/O v5.0.21", SheenModel::Microfiber),
+        ("glTF-Transform v4.1.0", SheenModel::Charlie),
+    ] {
+        let (buffer, mut document) = quad_facing_camera(material.clone(), "KHR_materials_sheen");
+        document["asset"] = json!({"generator": generator});
+        let path = write(dir.path(), "s.gltf", &buffer, document);
+        let loaded = load_scene(&path).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        let pbr = loaded.scene.materials[loaded.scene.meshes[0].material].pbr;
+        assert_eq!(pbr.sheen_model, model, "{generator}");
+        assert_eq!(pbr.sheen_colour, Vec3::new(1.0, 0.9, 0.8));
+        assert!((pbr.sheen_roughness - 0.5).abs() < 1e-6);
     }
 }

@@ -7,7 +7,9 @@ mod shapes;
 use glam::{Affine3A, Vec3};
 use gridtrace::load::load_scene;
 use gridtrace::render::{Image, RenderSettings, Renderer, Strategy};
-use gridtrace::scene::{Camera, Instance, Material, Motion, Pbr, Scene, SceneBuilder, TimeSlice};
+use gridtrace::scene::{
+    Camera, Instance, Material, Motion, Pbr, Scene, SceneBuilder, SheenModel, TimeSlice,
+};
 use shapes::{add_box_inside, add_quad, add_sphere, camera_at};
 
 /// What stands in the test room besides its diffuse walls.
@@ -17,8 +19,9 @@ enum Contents {
     Empty,
     /// An ideal mirror and an ideal glass sphere (delta lobes only).
     Ideal,
-    /// Glossy surfaces: a rough gold panel, a coated plastic sphere with sheen, rough glass,
-    /// so every non-delta lobe meets light sampling and MIS.
+    /// Glossy surfaces: a rough gold panel, a coated plastic sphere with sheen, a velvet
+    /// sphere (microfibre sheen), rough glass, so every non-delta lobe meets light sampling
+    /// and MIS.
     Glossy,
 }
 
@@ -137,6 +140,19 @@ fn test_room(contents: Contents) -> Scene {
                 },
             ));
             add_sphere(&mut b, v(-0.45, -0.7, 0.45), 0.3, plastic);
+            let velvet = b.add_material(Material::new(
+                "velvet",
+                Pbr {
+                    base_colour: Vec3::new(0.3, 0.05, 0.1),
+                    metallic: 0.0,
+                    roughness: 0.7,
+                    sheen_colour: Vec3::ONE,
+                    sheen_roughness: 0.3,
+                    sheen_model: SheenModel::Microfiber,
+                    ..Pbr::default()
+                },
+            ));
+            add_sphere(&mut b, v(0.55, -0.78, -0.55), 0.2, velvet);
         }
     }
     b.build()

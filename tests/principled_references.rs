@@ -116,3 +116,16 @@ fn udim_tiles_from_usd_match_cycles() {
 fn anisotropic_metal_and_plastic_match_cycles() {
     check("principled_anisotropy", "glb", SPP);
 }
+
+/// Velvet: a dark red base under a white sheen of roughness 0.2, 0.5 and 0.8. A file
+/// Blender wrote renders its sheen as Cycles' microfibre layer (over the coat), so it
+/// matches; the .usdc carries the sheen in its MaterialX network (OpenPBR `fuzz`).
+#[test]
+fn velvet_sheen_matches_cycles() {
+    check("principled_sheen", "glb", SPP);
+}
+
+#[test]
+fn velvet_sheen_from_usd_matches_cycles() {
+    check("principled_sheen", "usdc", SPP);
+}

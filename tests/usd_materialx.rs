@@ -6,7 +6,7 @@ use std::path::Path;
 
 use glam::{Affine2, Vec2, Vec3};
 use gridtrace::load::load_scene;
-use gridtrace::scene::{Material, Scene};
+use gridtrace::scene::{Material, Pbr, Scene, SheenModel};
 
 const STAGE: &str = "tests/data/scenes/third_party/usd_core_materialx.usda";
 
@@ -40,6 +40,8 @@ fn materials_referenced_from_a_materialx_document_have_its_values() {
     assert!((gold.pbr.roughness - 0.3).abs() < 1e-6);
     assert!((gold.pbr.clearcoat - 0.4).abs() < 1e-6);
     assert!((gold.pbr.clearcoat_roughness - 0.05).abs() < 1e-6);
+    // OpenPBR's fuzz is the microfibre layer; Standard Surface's sheen is Charlie's.
+    assert_eq!(gold.pbr.sheen_model, SheenModel::Microfiber);
 
     // Standard Surface glass: its transmission colour tints it; the base weight (0.8 by
     // default) belongs to the diffuse base it replaces.
@@ -52,6 +54,7 @@ fn materials_referenced_from_a_materialx_document_have_its_values() {
     );
     assert!((amber.pbr.ior - 1.52).abs() < 1e-6 && (amber.pbr.roughness - 0.05).abs() < 1e-6);
     assert_eq!(amber.pbr.metallic, 0.0);
+    assert_eq!(amber.pbr.sheen_model, SheenModel::Charlie);
 
     // A tiled image through a node graph with a file prefix: the texture beside the
     // document, repeated 4 × 2 times (MaterialX's v runs up the image, as USD's st do).
@@ -92,7 +95,8 @@ fn materials_referenced_from_a_materialx_document_have_its_values() {
 }
 
 /// The MaterialX material is the material the same values give through a
-/// UsdPreviewSurface, so the one BSDF it becomes renders both alike.
+/// UsdPreviewSurface, so the one BSDF it becomes renders both alike (but for the model of
+/// a sheen neither has: OpenPBR's is the microfibre layer).
 #[test]
 fn an_open_pbr_look_is_the_preview_surface_of_the_same_values() {
     let dir = tempfile::tempdir().unwrap();
@@ -128,17 +132,29 @@ def Xform "Balls"
     let looks = load_scene(Path::new(STAGE)).unwrap();
     let a = material(&preview.scene, "/Balls/Gold");
     let b = material(&looks.scene, "/Balls/Looks/Gold");
-    assert_eq!(a.pbr, b.pbr);
+    assert_eq!(b.pbr.sheen_colour, Vec3::ZERO);
+    let b_pbr = Pbr {
+        sheen_model: a.pbr.sheen_model,
+        ..b.pbr
+    };
+    assert_eq!(a.pbr, b_pbr);
     assert_eq!(a.emission, b.emission);
 }
 
 /// Blender's USD export with its MaterialX option writes an OpenPBR surface beside its
 /// preview surface; gridtrace reads the OpenPBR one, and every material of Blender's glass
-/// scene then equals the glTF export's (glass included, which the preview surface lacks).
+/// and velvet scenes then equals the glTF export's (glass and sheen included, which the
+/// preview surface lacks; both files, being Blender's, take Cycles' microfibre sheen).
 #[test]
 fn blenders_open_pbr_network_gives_the_gltf_materials() {
-    let usd = load_scene(Path::new("tests/data/scenes/principled_glass_tints.usdc")).unwrap();
-    let gltf = load_scene(Path::new("tests/data/scenes/principled_glass_tints.glb")).unwrap();
+    for scene in ["principled_glass_tints", "principled_sheen"] {
+        same_materials_in_usd_and_gltf(scene);
+    }
+}
+
+fn same_materials_in_usd_and_gltf(scene: &str) {
+    let usd = load_scene(Path::new(&format!("tests/data/scenes/{scene}.usdc"))).unwrap();
+    let gltf = load_scene(Path::new(&format!("tests/data/scenes/{scene}.glb"))).unwrap();
     assert!(usd.warnings.is_empty(), "{:?}", usd.warnings);
     for m in &gltf.scene.materials {
         let u = material(&usd.scene, &format!("/root/_materials/{}", m.name));
@@ -155,10 +171,20 @@ fn blenders_open_pbr_network_gives_the_gltf_materials() {
             ("roughness", u.pbr.roughness, m.pbr.roughness),
             ("ior", u.pbr.ior, m.pbr.ior),
             ("specular", u.pbr.specular, m.pbr.specular),
+            (
+                "sheen roughness",
+                u.pbr.sheen_roughness,
+                m.pbr.sheen_roughness,
+            ),
         ] {
             assert!((a - b).abs() < 1e-6, "{}: {what} {a} vs {b}", m.name);
         }
         assert!(near(u.emission, m.emission), "{}", m.name);
+        assert!(near(u.pbr.sheen_colour, m.pbr.sheen_colour), "{}", m.name);
+        if m.pbr.sheen_colour != Vec3::ZERO {
+            assert_eq!(m.pbr.sheen_model, SheenModel::Microfiber, "{}", m.name);
+            assert_eq!(u.pbr.sheen_model, SheenModel::Microfiber, "{}", m.name);
+        }
         assert_eq!(
             u.textures.metallic.is_some(),
             m.textures.metallic.is_some(),

@@ -152,9 +152,10 @@ fn material_summary(m: &Material, emitted: f32) -> String {
     if p.sheen_colour != Vec3::ZERO {
         let _ = write!(
             s,
-            ", sheen {} roughness {}",
+            ", sheen {} roughness {} ({:?})",
             vector(p.sheen_colour),
-            significant(p.sheen_roughness)
+            significant(p.sheen_roughness),
+            p.sheen_model
         );
     }
     if p.anisotropy.strength > 0.0 {

@@ -35,8 +35,10 @@ pub struct Pbr {
     pub clearcoat_roughness: f32,
     /// Colour of the sheen layer (zero: no sheen).
     pub sheen_colour: Vec3,
-    /// Perceptual roughness of the sheen (Charlie distribution).
+    /// Roughness of the sheen.
     pub sheen_roughness: f32,
+    /// Which sheen the file was authored against.
+    pub sheen_model: SheenModel,
     /// Stretch of the metal and specular lobes along a direction of the surface.
     pub anisotropy: Anisotropy,
 }
@@ -66,6 +68,21 @@ pub enum AnisotropyModel {
     Cycles,
 }
 
+/// The two sheens files are authored against: they differ in shape (Charlie peaks at
+/// grazing half vectors, the microfibre layer also scatters back) and in what a roughness
+/// means, so a velvet authored for one looks wrong in the other.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SheenModel {
+    /// `KHR_materials_sheen`: the "Charlie" distribution (Estevez & Kulla 2017), α =
+    /// roughness².
+    #[default]
+    Charlie,
+    /// Cycles' Principled BSDF (files Blender wrote): Zeltner, Burley & Chiang's (2022)
+    /// layer of fibres along the normal, as a linearly transformed cosine, on top of the
+    /// coat.
+    Microfiber,
+}
+
 impl Default for Pbr {
     /// glTF's defaults: white, metallic 1 and roughness 1 as `pbrMetallicRoughness` says,
     /// IOR 1.5 with the full specular layer, no transmission, coat or sheen.
@@ -82,6 +99,7 @@ impl Default for Pbr {
             clearcoat_roughness: 0.0,
             sheen_colour: Vec3::ZERO,
             sheen_roughness: 0.0,
+            sheen_model: SheenModel::Charlie,
             anisotropy: Anisotropy::default(),
         }
     }

@@ -18,7 +18,8 @@ pub use camera::{Camera, Projection, ThinLens};
 pub use environment::{Environment, EnvironmentMap, blender_world_rotation, map_direction, map_uv};
 pub use light::{Light, LightKind};
 pub use material::{
-    AlphaMode, Anisotropy, AnisotropyModel, ChannelRef, Material, MaterialTextures, Pbr, f0_of_ior,
+    AlphaMode, Anisotropy, AnisotropyModel, ChannelRef, Material, MaterialTextures, Pbr,
+    SheenModel, f0_of_ior,
 };
 pub use mesh::Mesh;
 pub use motion::{Motion, TimeSlice};

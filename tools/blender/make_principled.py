@@ -14,8 +14,8 @@ clamping, no denoising, 64 bounces, black world).
 - principled_metals: gold, steel and copper spheres at roughness 0.2, 0.5 and 0.8 on a floor and
   a wall that keep every Principled default (roughness 0.5, a 4 % specular layer).
 - principled_plastics: glossy (0.1) and rough (0.6) plastics and a clear-coated sphere.
-  (Sheen is not compared: Cycles' Principled sheen is its "microfiber" model, glTF's
-  KHR_materials_sheen is Charlie's, which gridtrace follows; see docs/manual/materials.md.)
+- principled_sheen: velvet, a dark red base under a white sheen of roughness 0.2, 0.5 and
+  0.8 (Cycles' microfibre sheen, which a file written by Blender renders with).
 - principled_textured: a metal panel whose roughness comes from a texture and whose normal from
   a normal map.
 - principled_glass_tints: single clear and tinted glass sheets, a closed yellow glass ball and
@@ -273,6 +273,14 @@ def build_specular(scene):
         sphere(name, mat, 0.5, (x, 0.0, 0.5))
 
 
+def build_sheen(scene):
+    room(scene)
+    for name, roughness, x in (("Velvet2", 0.2, -1.1), ("Velvet5", 0.5, 0.0), ("Velvet8", 0.8, 1.1)):
+        mat = blender_default(name, (0.3, 0.02, 0.05), Roughness=0.7,
+                              **{"Sheen Weight": 1.0, "Sheen Roughness": roughness})
+        sphere(name, mat, 0.5, (x, 0.0, 0.5))
+
+
 # name -> (builder, total reference samples)
 SCENE_TABLE = {
     "principled_metals": (build_metals, 2048),
@@ -284,9 +292,10 @@ SCENE_TABLE = {
     "principled_specular": (build_specular, 2048),
     "principled_udim": (build_udim, 1024),
     "principled_anisotropy": (build_anisotropy, 2048),
+    "principled_sheen": (build_sheen, 2048),
 }
-# Glass reaches USD only through the exporter's MaterialX network.
-MATERIALX = {"principled_glass", "principled_glass_tints"}
+# Glass and sheen reach USD only through the exporter's MaterialX network.
+MATERIALX = {"principled_glass", "principled_glass_tints", "principled_sheen"}
 
 
 def main():

@@ -8,7 +8,7 @@ use crate::limits::check_memory;
 use crate::load::images::decode_texture;
 use crate::scene::{
     AlphaMode, Anisotropy, AnisotropyModel, ChannelRef, Filter, Material, MaterialTextures, Pbr,
-    TextureRef, Wrap,
+    SheenModel, TextureRef, Wrap,
 };
 
 impl GltfLoader {
@@ -133,6 +133,10 @@ impl GltfLoader {
         if let Some(sheen) = material.extension_value("KHR_materials_sheen") {
             pbr.sheen_colour = json_vec3(&sheen["sheenColorFactor"], Vec3::ZERO);
             pbr.sheen_roughness = json_f32(&sheen["sheenRoughnessFactor"], 0.0);
+            // Blender's exporter writes the Principled BSDF's sheen, which is Cycles'.
+            if self.from_blender {
+                pbr.sheen_model = SheenModel::Microfiber;
+            }
             textures.sheen_colour = self.json_texture(document, &sheen["sheenColorTexture"], &name);
             textures.sheen_roughness = self
                 .json_texture(document, &sheen["sheenRoughnessTexture"], &name)

@@ -548,7 +548,11 @@ mod tests {
         let shallow = catmull_clark(&cage, Boundary::EdgeAndCorner, 1);
         let deep = catmull_clark(&cage, Boundary::EdgeAndCorner, 4);
         for (v, p) in shallow.points.iter().enumerate() {
-            assert!(p.abs_diff_eq(deep.points[v], 1e-5), "{v}: {p} vs {}", deep.points[v]);
+            assert!(
+                p.abs_diff_eq(deep.points[v], 1e-5),
+                "{v}: {p} vs {}",
+                deep.points[v]
+            );
         }
         // And the creases mattered: the smooth cube's limit is elsewhere.
         let smooth = catmull_clark(&cube(), Boundary::EdgeAndCorner, 1);

@@ -14,7 +14,9 @@ use openusd::sdf;
 use super::UsdLoader;
 use super::network::Source;
 use super::value::{as_f64, as_vec3};
-use crate::scene::{AlphaMode, ChannelRef, Material, MaterialTextures, Pbr, TextureRef, Wrap};
+use crate::scene::{
+    AlphaMode, ChannelRef, Material, MaterialTextures, Pbr, SheenModel, TextureRef, Wrap,
+};
 
 /// Where one shading model keeps each quantity the material description has, with the
 /// model's default for it.
@@ -34,6 +36,8 @@ struct Model {
     sheen: Option<&'static str>,
     sheen_colour: (&'static str, Vec3),
     sheen_roughness: (&'static str, f32),
+    /// The sheen the model's specification describes.
+    sheen_model: SheenModel,
     emission_colour: (&'static str, Vec3),
     emission: (&'static str, f32),
     opacity: &'static str,
@@ -57,6 +61,8 @@ const OPEN_PBR: Model = Model {
     sheen: Some("fuzz_weight"),
     sheen_colour: ("fuzz_color", Vec3::ONE),
     sheen_roughness: ("fuzz_roughness", 0.5),
+    // OpenPBR 1.1's fuzz is Zeltner et al.'s fibre layer, over the coat.
+    sheen_model: SheenModel::Microfiber,
     emission_colour: ("emission_color", Vec3::ONE),
     // Blender writes its Emission Strength here, radiance × colour as in Cycles.
     emission: ("emission_luminance", 0.0),
@@ -80,6 +86,8 @@ const STANDARD_SURFACE: Model = Model {
     sheen: Some("sheen"),
     sheen_colour: ("sheen_color", Vec3::ONE),
     sheen_roughness: ("sheen_roughness", 0.3),
+    // Standard Surface 1.0.1's sheen is Estevez & Kulla's.
+    sheen_model: SheenModel::Charlie,
     emission_colour: ("emission_color", Vec3::ONE),
     emission: ("emission", 0.0),
     opacity: "opacity",
@@ -102,6 +110,7 @@ const GLTF_PBR: Model = Model {
     sheen: None,
     sheen_colour: ("sheen_color", Vec3::ZERO),
     sheen_roughness: ("sheen_roughness", 0.0),
+    sheen_model: SheenModel::Charlie,
     emission_colour: ("emissive", Vec3::ZERO),
     emission: ("emissive_strength", 1.0),
     opacity: "alpha",
@@ -209,6 +218,11 @@ impl UsdLoader {
             clearcoat_roughness,
             sheen_colour: sheen_colour * sheen_weight,
             sheen_roughness,
+            sheen_model: if self.from_blender {
+                SheenModel::Microfiber
+            } else {
+                model.sheen_model
+            },
             ..Pbr::default()
         };
         let opacity = self.mtlx_opacity(shader, model.opacity, &name);

@@ -4,7 +4,7 @@
 //!
 //! ```text
 //! coat  ─ clear GGX dielectric (index 1.5, exact Fresnel × clearcoat)
-//!  └ sheen ─ Charlie sheen
+//!  └ sheen ─ Charlie sheen (the microfibre sheen lies over the coat instead)
 //!     └ metallic · GGX conductor (F0 = base colour; anisotropic along the tangent
 //!                  frame where the material says so, as is the dielectric layer)
 //!       + (1 − metallic)(1 − transmission) · [GGX dielectric layer over Lambertian base]
@@ -26,6 +26,7 @@ mod fresnel;
 mod glass;
 mod microfacet;
 mod sheen;
+mod sheen_table;
 mod specular;
 
 pub use fresnel::fresnel_dielectric;
@@ -35,11 +36,11 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::sampling::{Frame, cosine_hemisphere};
-use crate::scene::{Anisotropy, AnisotropyModel, Pbr, f0_of_ior};
+use crate::scene::{Anisotropy, AnisotropyModel, Pbr, SheenModel, f0_of_ior};
 use fresnel::Fresnel;
 use glass::GlassLobe;
 use microfacet::Ggx;
-use sheen::charlie_brdf;
+use sheen::SheenLayer;
 use specular::SpecularLobe;
 
 /// Index of the clear coat: 1.5, as `KHR_materials_clearcoat` fixes it (F0 = 0.04) and as
@@ -88,8 +89,8 @@ pub struct Bsdf {
     /// The coat's own frame, in the local frame of the shading normal, when a coat normal
     /// map tilts it (`KHR_materials_clearcoat`'s `clearcoatNormalTexture`).
     coat_frame: Option<Frame>,
-    /// Sheen colour and α, between the coat and the rest.
-    sheen: Option<(Vec3, f32)>,
+    /// The sheen: between the coat and the rest, or over the coat (microfibre).
+    sheen: Option<SheenLayer>,
     /// The cosine lobes' (diffuse base and sheen) own normal, when the shading normal has
     /// been raised for the glossy lobes ([`Bsdf::with_diffuse_normal`]): world space, and
     /// as a frame in the local frame of the glossy normal.
@@ -123,14 +124,17 @@ enum Strategy {
     Metal,
     Specular,
     Glass,
+    /// The microfibre sheen's own transformed cosine.
+    Sheen,
 }
 
-const STRATEGIES: [Strategy; 5] = [
+const STRATEGIES: [Strategy; 6] = [
     Strategy::Cosine,
     Strategy::Coat,
     Strategy::Metal,
     Strategy::Specular,
     Strategy::Glass,
+    Strategy::Sheen,
 ];
 
 impl Bsdf {
@@ -183,11 +187,10 @@ impl Bsdf {
             };
             SpecularLobe::new(pbr.clearcoat_roughness.clamp(0.0, 1.0), fresnel)
         });
-        let sheen = (pbr.sheen_colour.max_element() > 0.0).then(|| {
-            (
-                pbr.sheen_colour.clamp(Vec3::ZERO, Vec3::ONE),
-                pbr.sheen_roughness.clamp(0.0, 1.0),
-            )
+        let sheen = (pbr.sheen_colour.max_element() > 0.0).then(|| SheenLayer {
+            colour: pbr.sheen_colour.clamp(Vec3::ZERO, Vec3::ONE),
+            roughness: pbr.sheen_roughness.clamp(0.0, 1.0),
+            model: pbr.sheen_model,
         });
         Bsdf {
             diffuse: base * dielectric,
@@ -292,8 +295,11 @@ impl Bsdf {
         if let Some(c) = &self.coat {
             names.push(sharp(c.is_delta(), "smooth coat", "rough coat"));
         }
-        if self.sheen.is_some() {
-            names.push("sheen");
+        if let Some(sheen) = &self.sheen {
+            names.push(match sheen.model {
+                SheenModel::Charlie => "sheen",
+                SheenModel::Microfiber => "microfibre sheen",
+            });
         }
         if let Some((m, _)) = &self.metal {
             names.push(sharp(m.is_delta(), "mirror conductor", "GGX conductor"));
@@ -323,6 +329,7 @@ impl Bsdf {
     /// True when every lobe is a delta (light sampling is useless there).
     pub fn is_delta(&self) -> bool {
         !self.has_cosine_lobes()
+            && self.sheen.is_none()
             && self.coat.is_none_or(|c| c.is_delta())
             && self.metal.is_none_or(|(m, _)| m.is_delta())
             && self.specular.is_none_or(|(s, _)| s.is_delta())
@@ -340,9 +347,9 @@ impl Bsdf {
             && self.bump.is_none()
     }
 
-    /// True when the cosine strategy (Lambertian base, sheen) has anything to draw.
+    /// True when the cosine strategy (Lambertian base, Charlie sheen) has anything to draw.
     fn has_cosine_lobes(&self) -> bool {
-        self.diffuse.max_element() > 0.0 || self.sheen.is_some()
+        self.diffuse.max_element() > 0.0 || self.sheen.is_some_and(|s| !s.over_coat())
     }
 
     /// The factor the coat and sheen leave to what lies beneath them, for `wo` in the
@@ -352,9 +359,8 @@ impl Bsdf {
         if let Some(coat) = &self.coat {
             factor *= coat.transmitted(self.in_coat_frame(wo).z.max(0.0));
         }
-        if let Some((colour, roughness)) = self.sheen {
-            let mu = self.in_diffuse_frame(wo).z.max(0.0);
-            factor *= sheen_transmitted(colour, roughness, mu);
+        if let Some(sheen) = &self.sheen {
+            factor *= sheen.transmitted(self.in_diffuse_frame(wo));
         }
         factor
     }
@@ -374,18 +380,21 @@ impl Bsdf {
             return f;
         }
         let coat_wo = self.in_coat_frame(wo);
-        if let Some(coat) = &self.coat {
-            f += coat.eval(coat_wo, self.in_coat_frame(wi)) * wi.z;
-        }
         let (diffuse_wo, diffuse_wi) = (self.in_diffuse_frame(wo), self.in_diffuse_frame(wi));
-        let diffuse_cos = diffuse_wi.z.max(0.0) * self.bump_shadowing(wi);
-        if let Some((colour, roughness)) = self.sheen {
-            let factor = self
-                .coat
-                .map_or(Vec3::ONE, |c| c.transmitted(coat_wo.z.max(0.0)));
+        let sheen_over_coat = self.sheen.filter(|s| s.over_coat());
+        if let Some(coat) = &self.coat {
+            let factor = sheen_over_coat.map_or(Vec3::ONE, |s| s.transmitted(diffuse_wo));
+            f += factor * coat.eval(coat_wo, self.in_coat_frame(wi)) * wi.z;
+        }
+        let shadowing = self.bump_shadowing(wi);
+        let diffuse_cos = diffuse_wi.z.max(0.0) * shadowing;
+        if let Some(sheen) = &self.sheen {
+            let factor = match (&self.coat, sheen.over_coat()) {
+                (Some(c), false) => c.transmitted(coat_wo.z.max(0.0)),
+                _ => Vec3::ONE,
+            };
             if diffuse_wo.z > 0.0 && diffuse_cos > 0.0 {
-                let sheen = charlie_brdf(roughness * roughness, diffuse_wo, diffuse_wi);
-                f += factor * colour * (sheen * diffuse_cos);
+                f += factor * sheen.eval(diffuse_wo, diffuse_wi) * shadowing;
             }
         }
         if let Some((metal, w)) = &self.metal {
@@ -400,24 +409,31 @@ impl Bsdf {
     }
 
     /// How often each strategy is chosen, in proportion to the albedo it covers at `wo`.
-    fn strategy_weights(&self, wo: Vec3) -> [f32; 5] {
+    fn strategy_weights(&self, wo: Vec3) -> [f32; 6] {
         let mean = |v: Vec3| v.element_sum() / 3.0;
         let mu_o = wo.z;
         let mut top = 1.0;
         let mut coat = 0.0;
         let mut cosine = 0.0;
+        let mut sheen_weight = 0.0;
+        let sheen_albedo = self.sheen.map(|s| {
+            let e = s.colour.max_element() * s.white_albedo(self.in_diffuse_frame(wo));
+            (s, e)
+        });
+        if let Some((_, e)) = sheen_albedo.filter(|(s, _)| s.over_coat()) {
+            sheen_weight = e;
+            top = 1.0 - e;
+        }
         if let Some(c) = &self.coat {
             let coat_mu = self.in_coat_frame(wo).z;
             coat = if coat_mu > 0.0 {
-                mean(c.albedo(coat_mu))
+                top * mean(c.albedo(coat_mu))
             } else {
                 0.0
             };
-            top = 1.0 - coat;
+            top -= coat;
         }
-        if let Some((colour, roughness)) = self.sheen {
-            let mu = self.in_diffuse_frame(wo).z.max(0.0);
-            let e = colour.max_element() * albedo::tables().sheen(mu, roughness);
+        if let Some((_, e)) = sheen_albedo.filter(|(s, _)| !s.over_coat()) {
             cosine += top * e;
             top *= 1.0 - e;
         }
@@ -434,11 +450,11 @@ impl Bsdf {
         cosine += top * mean(self.diffuse * under);
         // Glass passes or reflects almost everything, whatever its tint.
         let glass = self.glass.map_or(0.0, |(_, w)| top * w);
-        [cosine, coat, metal, specular, glass].map(|w| w.max(0.0))
+        [cosine, coat, metal, specular, glass, sheen_weight].map(|w| w.max(0.0))
     }
 
     /// Solid-angle pdf of `wi` over the non-delta strategies, local frame.
-    fn pdf_local(&self, wo: Vec3, wi: Vec3, weights: &[f32; 5]) -> f32 {
+    fn pdf_local(&self, wo: Vec3, wi: Vec3, weights: &[f32; 6]) -> f32 {
         let total: f32 = weights.iter().sum();
         if total <= 0.0 || wo.z <= 0.0 {
             return 0.0;
@@ -458,6 +474,10 @@ impl Bsdf {
                 Strategy::Metal => self.metal.map_or(0.0, |(m, _)| m.pdf_visible(wo, wi)),
                 Strategy::Specular => self.specular.map_or(0.0, |(s, _)| s.pdf_visible(wo, wi)),
                 Strategy::Glass => self.glass.map_or(0.0, |(g, _)| g.pdf(wo, wi)),
+                Strategy::Sheen if wi.z > 0.0 => self
+                    .microfiber(wo)
+                    .map_or(0.0, |m| m.pdf(self.in_diffuse_frame(wi))),
+                Strategy::Sheen => 0.0,
             };
             pdf += w * p;
         }
@@ -562,6 +582,11 @@ impl Bsdf {
             Strategy::Metal => self.metal.and_then(|(m, _)| m.sample_visible(wo, u)),
             Strategy::Specular => self.specular.and_then(|(s, _)| s.sample_visible(wo, u)),
             Strategy::Glass => self.glass.and_then(|(g, _)| g.sample_rough(wo, u, u_rest)),
+            Strategy::Sheen => self.microfiber(wo).map(|m| {
+                let wi = m.sample(u);
+                self.diffuse_normal
+                    .map_or(wi, |(_, frame)| frame.to_world(wi))
+            }),
         }?;
         let pdf = self.pdf_local(wo, wi, &weights);
         let f = self.eval_local(wo, wi);
@@ -614,16 +639,14 @@ impl Bsdf {
                     s.is_transmission,
                 ))
             }
-            Strategy::Cosine => None,
+            Strategy::Cosine | Strategy::Sheen => None,
         }
     }
-}
 
-/// What a sheen of `colour` leaves to the layers beneath it: `KHR_materials_sheen`'s
-/// albedo scaling 1 − max(colour)·E(μo), with the white sheen's albedo from the tables.
-fn sheen_transmitted(colour: Vec3, roughness: f32, mu_o: f32) -> Vec3 {
-    let e = albedo::tables().sheen(mu_o, roughness);
-    Vec3::splat((1.0 - colour.max_element() * e).max(0.0))
+    /// The microfibre sheen's lobe seen from `wo` (shading frame), when it has one.
+    fn microfiber(&self, wo: Vec3) -> Option<sheen::Microfiber> {
+        self.sheen?.microfiber(self.in_diffuse_frame(wo))
+    }
 }
 
 #[cfg(test)]
