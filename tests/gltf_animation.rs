@@ -142,3 +142,28 @@ fn sparse_rewrites_pose_the_same() {
         assert_eq!(world_corners(&ours), world_corners(&reference));
     }
 }
+
+/// Blender's experimental "Animation Pointer" export writes material animation as
+/// `KHR_animation_pointer` channels, which target no node: the file loads, with one warning
+/// naming the extension as ignored (the material keeps its stored values), and its node
+/// animation plays — the cube's centre at x 0.1 at frame 1 and 2.0 at frame 20.
+#[test]
+fn animation_pointer_channels_are_ignored_and_node_animation_plays() {
+    let path = scene_file("pointer.glb");
+    for (frame, x) in [(1.0, 0.1f32), (20.0, 2.0)] {
+        let (scene, warnings) = load_at(&path, Some(frame), None);
+        assert_eq!(warnings.len(), 1, "{warnings:#?}");
+        assert!(
+            warnings
+                .iter()
+                .any(|w| w.contains("pointer.glb") && w.contains("KHR_animation_pointer")),
+            "{warnings:#?}"
+        );
+        let corners = world_corners(&scene);
+        let centre = corners.iter().map(|c| c.x).sum::<f32>() / corners.len() as f32;
+        assert!(
+            (centre - x).abs() < 1e-4,
+            "frame {frame}: centre x {centre}"
+        );
+    }
+}

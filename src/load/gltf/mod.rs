@@ -17,6 +17,7 @@ mod instancing;
 mod material;
 mod meshopt;
 mod nodes;
+mod pointer;
 mod primitive;
 mod spec_gloss;
 
@@ -95,8 +96,7 @@ pub fn load_bytes_with(
         message,
     };
     check_glb_header(bytes, path).map_err(gltf_error)?;
-    let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(e.to_string()))?;
+    let gltf::Gltf { document, blob } = pointer::parse(bytes).map_err(gltf_error)?;
     let mut warnings = Vec::new();
     check_extensions(path, &document, &mut warnings)?;
     validate(&document).map_err(gltf_error)?;
