@@ -31,6 +31,11 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     let plan = plan::plan_outputs(args, request)?;
     let pool = thread_pool(args.threads)?;
     let load_start = Instant::now();
+    // Parsing mostly keeps one core busy: the BSDF tables are integrated beside it,
+    // unless one thread was asked for.
+    if args.threads != Some(1) {
+        std::thread::spawn(crate::render::warm_tables);
+    }
     let prepared = prepare::prepare(args, &plan)?;
     let renderer = pool.install(|| Renderer::new(&prepared.scene));
     if !args.image.quiet {

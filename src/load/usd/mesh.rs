@@ -111,6 +111,76 @@ pub(super) fn pick<T: Copy>(
     }
 }
 
+/// The vertices and triangles of `mesh` from the face-corner `triangles` of `polygons`.
+/// When every attribute is per point (or constant), corners of one point share a vertex, as
+/// the file does; otherwise each corner is its own vertex, since normals, texture
+/// coordinates or colours may differ at every corner.
+fn fill_vertices(
+    mesh: &mut Mesh,
+    polygons: &Polygons,
+    triangles: &[[usize; 3]],
+    corner_face: &[usize],
+    colours: bool,
+) {
+    let per_point = |i: Option<Interpolation>| {
+        i.is_none_or(|i| matches!(i, Interpolation::Constant | Interpolation::Vertex))
+    };
+    let shared = per_point(polygons.normals.as_ref().map(|n| n.1))
+        && per_point(polygons.uvs.as_ref().map(|n| n.1))
+        && (!colours
+            || per_point(polygons.display_colour.as_ref().map(|n| n.1))
+                && per_point(polygons.display_opacity.as_ref().map(|n| n.1)));
+    let mut normals_ok = polygons.normals.is_some();
+    let mut st = Vec::new();
+    let mut vertex_of = vec![u32::MAX; if shared { polygons.points.len() } else { 0 }];
+    for tri in triangles {
+        let mut triangle = [0u32; 3];
+        for (k, &corner) in tri.iter().enumerate() {
+            let (face, point) = (corner_face[corner], polygons.indices[corner]);
+            if shared && vertex_of[point] != u32::MAX {
+                triangle[k] = vertex_of[point];
+                continue;
+            }
+            triangle[k] = mesh.positions.len() as u32;
+            if shared {
+                vertex_of[point] = triangle[k];
+            }
+            mesh.positions.push(polygons.points[point]);
+            if let Some(normals) = &polygons.normals {
+                match pick(normals, corner, face, point) {
+                    Some(n) => mesh.normals.push(n.normalize_or_zero()),
+                    None => normals_ok = false,
+                }
+            }
+            if let Some(uvs) = &polygons.uvs {
+                let v = pick(uvs, corner, face, point);
+                // USD's st has v up the image; glTF's (and ours) runs down.
+                st.push(v.map_or(Vec2::ZERO, |v| Vec2::new(v.x, 1.0 - v.y)));
+            }
+            if colours {
+                let rgb = polygons
+                    .display_colour
+                    .as_ref()
+                    .and_then(|c| pick(c, corner, face, point))
+                    .unwrap_or(Vec3::ONE);
+                let alpha = polygons
+                    .display_opacity
+                    .as_ref()
+                    .and_then(|o| pick(o, corner, face, point))
+                    .unwrap_or(1.0);
+                mesh.colours.push(rgb.extend(alpha));
+            }
+        }
+        mesh.indices.push(triangle);
+    }
+    if !normals_ok || mesh.normals.contains(&Vec3::ZERO) {
+        mesh.normals.clear();
+    }
+    if !st.is_empty() {
+        mesh.uvs = vec![st];
+    }
+}
+
 /// Bytes a face of a subdivision surface costs by the time it is rendered: its corners,
 /// points and texture coordinates, the levels before it, its triangles, normals and its
 /// share of the grid. Measured as the peak of a whole render of a 1,024-quad cage at level
@@ -317,105 +387,31 @@ impl UsdLoader {
 
     /// Triangulates `polygons` into scene meshes, one per material, named `where_`.
     pub(super) fn emit(&mut self, where_: &str, polygons: &Polygons) -> Vec<usize> {
-        let Polygons {
-            points,
-            counts,
-            indices,
-            normals,
-            uvs,
-            ..
-        } = polygons;
         let display = self.display_material(polygons);
-        let mut face_start = Vec::with_capacity(counts.len());
-        let mut start = 0usize;
-        for &c in counts {
-            face_start.push(start);
-            start += c;
-        }
-        let mut by_material: HashMap<usize, Vec<[usize; 3]>> = HashMap::new();
-        for (face, &count) in counts.iter().enumerate() {
-            let first = face_start[face];
-            let corners: Vec<usize> = (first..first + count).collect();
-            let polygon: Vec<Vec3> = corners.iter().map(|&c| points[indices[c]]).collect();
-            let triangles = triangulate(&polygon).unwrap_or_else(|| {
-                self.warn(format!(
-                    "{where_}: face {face} is a concave polygon of {count} corners, more than \
-                     {MAX_EAR_CLIPPED_CORNERS} are ear-clipped; covered by a fan, which may \
-                     overlap itself"
-                ));
-                fan(polygon.len())
-            });
-            let material = polygons.face_material[face].unwrap_or(display);
-            for [a, b, c] in triangles {
-                let tri = [corners[a], corners[b], corners[c]];
-                let tri = if polygons.left_handed {
-                    [tri[0], tri[2], tri[1]]
-                } else {
-                    tri
-                };
-                by_material.entry(material).or_default().push(tri);
-            }
-        }
-        let corner_face: Vec<usize> = counts
+        let mut materials: Vec<(usize, Vec<[usize; 3]>)> = self
+            .triangles_by_material(where_, polygons, display)
+            .into_iter()
+            .collect();
+        materials.sort_by_key(|(m, _)| *m);
+        let corner_face: Vec<usize> = polygons
+            .counts
             .iter()
             .enumerate()
             .flat_map(|(f, &c)| std::iter::repeat_n(f, c))
             .collect();
-        let mut materials: Vec<(usize, Vec<[usize; 3]>)> = by_material.into_iter().collect();
-        materials.sort_by_key(|(m, _)| *m);
         let mut meshes = Vec::new();
         for (material, triangles) in materials {
-            // One vertex per triangle corner: normals and UVs may differ at every corner.
             let mut mesh = Mesh {
                 name: where_.to_string(),
                 material,
                 ..Mesh::default()
             };
-            let mut normals_ok = normals.is_some();
-            let mut st = Vec::new();
             // The display material, or a bound one whose colour reads displayColor.
             let reads_colours =
                 material == display || self.builder.material_mut(material).vertex_colours;
             let colours = reads_colours
                 && (polygons.display_colour.is_some() || polygons.display_opacity.is_some());
-            for (t, tri) in triangles.iter().enumerate() {
-                for &corner in tri {
-                    let (face, point) = (corner_face[corner], indices[corner]);
-                    mesh.positions.push(points[point]);
-                    if let Some(normals) = normals {
-                        match pick(normals, corner, face, point) {
-                            Some(n) => mesh.normals.push(n.normalize_or_zero()),
-                            None => normals_ok = false,
-                        }
-                    }
-                    if let Some(uvs) = uvs {
-                        let v = pick(uvs, corner, face, point);
-                        // USD's st has v up the image; glTF's (and ours) runs down.
-                        st.push(v.map_or(Vec2::ZERO, |v| Vec2::new(v.x, 1.0 - v.y)));
-                    }
-                    if colours {
-                        let rgb = polygons
-                            .display_colour
-                            .as_ref()
-                            .and_then(|c| pick(c, corner, face, point))
-                            .unwrap_or(Vec3::ONE);
-                        let alpha = polygons
-                            .display_opacity
-                            .as_ref()
-                            .and_then(|o| pick(o, corner, face, point))
-                            .unwrap_or(1.0);
-                        mesh.colours.push(rgb.extend(alpha));
-                    }
-                }
-                let base = 3 * t as u32;
-                mesh.indices.push([base, base + 1, base + 2]);
-            }
-            if !normals_ok || mesh.normals.contains(&Vec3::ZERO) {
-                mesh.normals.clear();
-            }
-            if !st.is_empty() {
-                mesh.uvs = vec![st];
-            }
+            fill_vertices(&mut mesh, polygons, &triangles, &corner_face, colours);
             if !polygons.double_sided {
                 mesh.material = self.one_sided(material);
             }
@@ -434,6 +430,54 @@ impl UsdLoader {
             meshes.push(self.builder.add_full_mesh(mesh));
         }
         meshes
+    }
+
+    /// The faces of `polygons` as triangles of face corners, by material (`display` for
+    /// faces no subset binds). Triangles need no triangulation; a polygon is triangulated
+    /// by its shape.
+    fn triangles_by_material(
+        &mut self,
+        where_: &str,
+        polygons: &Polygons,
+        display: usize,
+    ) -> HashMap<usize, Vec<[usize; 3]>> {
+        let Polygons {
+            points,
+            counts,
+            indices,
+            ..
+        } = polygons;
+        let mut by_material: HashMap<usize, Vec<[usize; 3]>> = HashMap::new();
+        let mut first = 0;
+        for (face, &count) in counts.iter().enumerate() {
+            let material = polygons.face_material[face].unwrap_or(display);
+            let out = by_material.entry(material).or_default();
+            let mut push = |[a, b, c]: [usize; 3]| {
+                let tri = [first + a, first + b, first + c];
+                out.push(if polygons.left_handed {
+                    [tri[0], tri[2], tri[1]]
+                } else {
+                    tri
+                });
+            };
+            if count == 3 {
+                push([0, 1, 2]);
+            } else {
+                let polygon: Vec<Vec3> =
+                    (first..first + count).map(|c| points[indices[c]]).collect();
+                let triangles = triangulate(&polygon).unwrap_or_else(|| {
+                    self.warn(format!(
+                        "{where_}: face {face} is a concave polygon of {count} corners, more \
+                         than {MAX_EAR_CLIPPED_CORNERS} are ear-clipped; covered by a fan, \
+                         which may overlap itself"
+                    ));
+                    fan(polygon.len())
+                });
+                triangles.into_iter().for_each(&mut push);
+            }
+            first += count;
+        }
+        by_material
     }
 
     /// Puts `meshes` into the scene at `world`, or into the prototype being collected.

@@ -31,6 +31,14 @@ mod specular;
 
 pub use fresnel::fresnel_dielectric;
 
+/// Integrates the albedo tables every layered or glass material needs (about 0.1 s of one
+/// core), so that a caller can do it beside work that leaves a core idle, such as parsing
+/// a scene; the first material that needs them otherwise waits for them.
+pub fn warm_tables() {
+    albedo::tables();
+    albedo::glass_table();
+}
+
 use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
