@@ -9,7 +9,10 @@ const EXTENSION: &[u8] = b"KHR_animation_pointer";
 
 /// The document and binary chunk of glTF or GLB `bytes`, without pointer channels.
 pub fn parse(bytes: &[u8]) -> Result<gltf::Gltf, String> {
-    if !bytes.windows(EXTENSION.len()).any(|w| w == EXTENSION) {
+    if !json_part(bytes)
+        .windows(EXTENSION.len())
+        .any(|w| w == EXTENSION)
+    {
         return gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string());
     }
     let (json, blob) = if bytes.starts_with(b"glTF") {
@@ -34,4 +37,15 @@ pub fn parse(bytes: &[u8]) -> Result<gltf::Gltf, String> {
         document: gltf::Document::from_json_without_validation(root),
         blob,
     })
+}
+
+/// The bytes that can hold the JSON: a GLB's first chunk (its length at bytes 12–15), or
+/// the whole of a .gltf. Searching there keeps the check off the binary chunk.
+fn json_part(bytes: &[u8]) -> &[u8] {
+    if bytes.starts_with(b"glTF") && bytes.len() >= 20 {
+        let length = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
+        &bytes[20..bytes.len().min(20 + length)]
+    } else {
+        bytes
+    }
 }
