@@ -129,3 +129,16 @@ fn velvet_sheen_matches_cycles() {
 fn velvet_sheen_from_usd_matches_cycles() {
     check("principled_sheen", "usdc", SPP);
 }
+
+/// A lamp shade modelled as one surface (an open cylinder of rough tinted glass) lit from
+/// inside by an emitting ball: the room is lit through one crossing of a thin sheet, tinted
+/// by √(base colour) and not scaled by 1/η², as in Cycles.
+#[test]
+fn lamp_shade_lit_from_inside_matches_cycles() {
+    check("principled_lamp_shade", "glb", SPP);
+}
+
+#[test]
+fn lamp_shade_lit_from_inside_from_usd_matches_cycles() {
+    check("principled_lamp_shade", "usdc", SPP);
+}

@@ -14,6 +14,9 @@ clamping, no denoising, 64 bounces, black world).
 - principled_metals: gold, steel and copper spheres at roughness 0.2, 0.5 and 0.8 on a floor and
   a wall that keep every Principled default (roughness 0.5, a 4 % specular layer).
 - principled_plastics: glossy (0.1) and rough (0.6) plastics and a clear-coated sphere.
+- principled_lamp_shade: a lamp shade modelled as one surface (an open cylinder, glass of
+  roughness 0.3 tinted (1, 0.85, 0.6)) lit from inside by an emitting ball that nearly fills it, on a
+  table-high box in the room; the light leaves through one crossing of a thin sheet.
 - principled_sheen: velvet, a dark red base under a white sheen of roughness 0.2, 0.5 and
   0.8 (Cycles' microfibre sheen, which a file written by Blender renders with).
 - principled_textured: a metal panel whose roughness comes from a texture and whose normal from
@@ -42,7 +45,7 @@ import sys
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from make_cornell import export, principled, quad, reset, sphere  # noqa: E402
+from make_cornell import box, export, principled, quad, reset, sphere  # noqa: E402
 from make_references import (  # noqa: E402
     SCENES, add_camera, export_usd, make_image, render_reference, scene_arguments,
 )
@@ -281,6 +284,22 @@ def build_sheen(scene):
         sphere(name, mat, 0.5, (x, 0.0, 0.5))
 
 
+def build_lamp_shade(scene):
+    room(scene)
+    stand = blender_default("Stand", (0.3, 0.3, 0.32), Roughness=0.4)
+    box("Stand", stand, (0.5, 0.5, 0.5), (0.0, 0.2, 0.0), 20.0)
+    shade = blender_default("Shade", (1.0, 0.85, 0.6), Roughness=0.3,
+                            **{"Transmission Weight": 1.0})
+    bpy.ops.mesh.primitive_cylinder_add(vertices=32, radius=0.3, depth=0.45, end_fill_type="NOTHING",
+                                        location=(0.0, 0.2, 0.8))
+    cylinder = bpy.context.active_object
+    cylinder.name = "Shade"
+    bpy.ops.object.shade_smooth()
+    cylinder.data.materials.append(shade)
+    bulb = principled("Bulb", (0.0, 0.0, 0.0), emission=(1.0, 0.9, 0.75), strength=6.0)
+    sphere("Bulb", bulb, 0.2, (0.0, 0.2, 0.8))
+
+
 # name -> (builder, total reference samples)
 SCENE_TABLE = {
     "principled_metals": (build_metals, 2048),
@@ -293,9 +312,10 @@ SCENE_TABLE = {
     "principled_udim": (build_udim, 1024),
     "principled_anisotropy": (build_anisotropy, 2048),
     "principled_sheen": (build_sheen, 2048),
+    "principled_lamp_shade": (build_lamp_shade, 4096),
 }
 # Glass and sheen reach USD only through the exporter's MaterialX network.
-MATERIALX = {"principled_glass", "principled_glass_tints", "principled_sheen"}
+MATERIALX = {"principled_glass", "principled_glass_tints", "principled_sheen", "principled_lamp_shade"}
 
 
 def main():
