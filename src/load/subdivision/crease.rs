@@ -169,13 +169,12 @@ pub(super) fn semi_sharp_limits(mesh: &Cage, boundary: Boundary, limits: &mut [V
     if mesh.sharpness.is_empty() {
         return;
     }
+    let starts = super::face_starts(&mesh.counts);
     let mut faces_of: HashMap<usize, Vec<usize>> = HashMap::new();
-    let mut start = 0;
-    for (f, &count) in mesh.counts.iter().enumerate() {
+    for (f, (&count, &start)) in mesh.counts.iter().zip(&starts).enumerate() {
         for &v in &mesh.indices[start..start + count] {
             faces_of.entry(v).or_default().push(f);
         }
-        start += count;
     }
     let mut affected: Vec<usize> = mesh
         .sharpness
@@ -193,15 +192,6 @@ pub(super) fn semi_sharp_limits(mesh: &Cage, boundary: Boundary, limits: &mut [V
         .collect();
     affected.sort_unstable();
     affected.dedup();
-    let starts: Vec<usize> = mesh
-        .counts
-        .iter()
-        .scan(0, |s, &c| {
-            let first = *s;
-            *s += c;
-            Some(first)
-        })
-        .collect();
     for v in affected {
         let faces = faces_of.get(&v).map_or(&[][..], Vec::as_slice);
         let mut local = neighbourhood(mesh, &starts, faces, v);

@@ -252,18 +252,22 @@ fn edges(mesh: &Cage) -> Edges {
     }
 }
 
-/// One level of Catmull–Clark.
-fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
-    let edges = edges(mesh);
-    let starts: Vec<usize> = mesh
-        .counts
+/// Where each face's corners start in a mesh whose faces have `counts` corners.
+fn face_starts(counts: &[usize]) -> Vec<usize> {
+    counts
         .iter()
         .scan(0, |s, &c| {
             let start = *s;
             *s += c;
             Some(start)
         })
-        .collect();
+        .collect()
+}
+
+/// One level of Catmull–Clark.
+fn refine(mesh: &Cage, boundary: Boundary) -> Cage {
+    let edges = edges(mesh);
+    let starts = face_starts(&mesh.counts);
     let corners = |f: usize| &mesh.indices[starts[f]..starts[f] + mesh.counts[f]];
     let face_points: Vec<Vec3> = (0..mesh.counts.len())
         .map(|f| {
@@ -513,19 +517,23 @@ mod tests {
         }
     }
 
-    /// A cube whose every edge is infinitely sharp stays a cube: each face refines flat
-    /// between straight creases.
-    #[test]
-    fn a_cube_with_sharp_edges_stays_a_cube() {
+    /// The cube with every edge creased to `sharpness`.
+    fn creased_cube(sharpness: f32) -> Cage {
         let mut cage = cube();
         for face in cage.indices.clone().chunks(4) {
             for i in 0..4 {
                 let (a, b) = (face[i], face[(i + 1) % 4]);
-                cage.sharpness
-                    .edges
-                    .insert((a.min(b), a.max(b)), INFINITE_SHARPNESS);
+                cage.sharpness.edges.insert((a.min(b), a.max(b)), sharpness);
             }
         }
+        cage
+    }
+
+    /// A cube whose every edge is infinitely sharp stays a cube: each face refines flat
+    /// between straight creases.
+    #[test]
+    fn a_cube_with_sharp_edges_stays_a_cube() {
+        let cage = creased_cube(INFINITE_SHARPNESS);
         let refined = catmull_clark(&cage, Boundary::EdgeAndCorner, 3);
         for p in &refined.points {
             assert!((p.abs().max_element() - 1.0).abs() < 1e-6, "{p}");
@@ -537,13 +545,7 @@ mod tests {
     /// edge and 1.5 at one corner, limits at level 1 against level 4.
     #[test]
     fn semi_sharp_limits_are_those_of_deeper_refinement() {
-        let mut cage = cube();
-        for face in cage.indices.clone().chunks(4) {
-            for i in 0..4 {
-                let (a, b) = (face[i], face[(i + 1) % 4]);
-                cage.sharpness.edges.insert((a.min(b), a.max(b)), 2.5);
-            }
-        }
+        let mut cage = creased_cube(2.5);
         cage.sharpness.points.insert(0, 1.5);
         let shallow = catmull_clark(&cage, Boundary::EdgeAndCorner, 1);
         let deep = catmull_clark(&cage, Boundary::EdgeAndCorner, 4);
