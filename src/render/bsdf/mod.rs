@@ -31,14 +31,6 @@ mod specular;
 
 pub use fresnel::fresnel_dielectric;
 
-/// Integrates the albedo tables every layered or glass material needs (about 0.1 s of one
-/// core), so that a caller can do it beside work that leaves a core idle, such as parsing
-/// a scene; the first material that needs them otherwise waits for them.
-pub fn warm_tables() {
-    albedo::tables();
-    albedo::glass_table();
-}
-
 use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
@@ -50,6 +42,14 @@ use glass::GlassLobe;
 use microfacet::Ggx;
 use sheen::SheenLayer;
 use specular::SpecularLobe;
+
+/// Integrates the albedo tables every layered or glass material needs (about 0.1 s of one
+/// core), so that a caller can do it beside work that leaves a core idle, such as parsing
+/// a scene; the first material that needs them otherwise waits for them.
+pub fn warm_tables() {
+    albedo::tables();
+    albedo::glass_table();
+}
 
 /// Index of the clear coat: 1.5, as `KHR_materials_clearcoat` fixes it (F0 = 0.04) and as
 /// Cycles' coat defaults.
