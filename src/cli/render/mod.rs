@@ -29,7 +29,6 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         return Ok(Outcome::Completed);
     }
     let plan = plan::plan_outputs(args, request)?;
-    let pool = thread_pool(args.threads)?;
     let load_start = Instant::now();
     // Parsing mostly keeps one core busy: the BSDF tables are integrated beside it,
     // unless one thread was asked for.
@@ -37,6 +36,10 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
         std::thread::spawn(crate::render::warm_tables);
     }
     let prepared = prepare::prepare(args, &plan)?;
+    // The workers start only now: a USD stage is first read in a forked child, and a
+    // worker caught starting up at the fork (initialising a process-wide value its thread
+    // pool shares with the child's image decoders) would leave the child waiting for ever.
+    let pool = thread_pool(args.threads)?;
     let renderer = pool.install(|| Renderer::new(&prepared.scene));
     if !args.image.quiet {
         report::prepared(&plan, &prepared, &renderer, load_start.elapsed());

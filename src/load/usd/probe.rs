@@ -100,10 +100,14 @@ pub fn probe_stage(path: &Path, load: impl FnOnce() -> bool) -> Result<(), LoadE
     }
     // Wait as long as the read takes: the reader can be slow on a large stage, and a stage
     // on which it loops is ended by the command line's load timeout (`--load-timeout`),
-    // which takes this child with it. The threads alive at the fork (signal handling, idle
-    // workers) hold no lock the child needs; the one they could hold, the backtrace lock,
-    // is never taken when library backtraces are off (`RUST_LIB_BACKTRACE=0`, which the
-    // command line and the test script set).
+    // which takes this child with it. The child inherits every lock and once-only
+    // initialisation as some other thread left it at the fork, so the command line forks
+    // before its render workers exist: a worker starting up initialises the deque
+    // collector that the child's image decoders' threads also need, and one caught midway
+    // leaves the child waiting for ever. The threads alive at the fork (signal handling,
+    // the load timeout, the BSDF tables' integration) touch nothing the child uses; the
+    // backtrace lock is never taken when library backtraces are off (`RUST_LIB_BACKTRACE=0`,
+    // which the command line and the test script set).
     let mut status = 0;
     let waited = loop {
         // SAFETY: waits for the child forked above, with a valid status pointer.
