@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand};
 
 use super::choices::{
-    FilterChoice, LightUnitsChoice, ProgressChoice, SoftFalloffChoice, ViewChoice,
+    FilterChoice, GuidingChoice, LightUnitsChoice, ProgressChoice, SoftFalloffChoice, ViewChoice,
 };
 use super::values::{
     EnvironmentChoice, parse_degrees, parse_distance, parse_environment, parse_exposure,
@@ -168,6 +168,12 @@ pub struct SamplingArgs {
     /// later), writing the samples taken; the image's record says how many.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub time_limit: Option<f64>,
+
+    /// Path guiding: a guide of the incident light, trained in 8 samples per pixel before
+    /// the first sample, proposes half the directions at rough surfaces. It pays where
+    /// light arrives through glass; auto turns it on when some material transmits light.
+    #[arg(long, value_enum, value_name = "WHEN", default_value = "auto")]
+    pub guiding: GuidingChoice,
 
     /// Pixel filter, sampled by filter importance sampling (each sample lands in one pixel,
     /// weight 1, so parts still merge exactly). Cycles' default is blackman-harris 1.5.

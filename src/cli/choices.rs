@@ -40,7 +40,18 @@ pub enum SoftFalloffChoice {
     Off,
 }
 
-/// Which pixel filter.
+/// `--guiding`: whether paths are guided ([`crate::render::Guiding`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum GuidingChoice {
+    /// On when some material transmits light (glass, a window, a lamp shade).
+    #[default]
+    Auto,
+    /// Always.
+    On,
+    /// Never.
+    Off,
+}
+
 /// `--progress`: how progress is reported for programs (the Blender add-on).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ProgressChoice {

@@ -9,7 +9,7 @@ use super::environment::{EnvironmentSetting, EnvironmentSource};
 use super::motion::Shutter;
 use crate::load::LoadOptions;
 use crate::record::RenderIdentity;
-use crate::render::{FilterKind, RenderSettings};
+use crate::render::{FilterKind, Guiding, RenderSettings};
 use crate::scene::Camera;
 
 /// What the render's options say beyond the settings: how the scene was read, with what
@@ -45,14 +45,23 @@ pub fn render_identity(
         seed: settings.seed,
         max_depth: settings.max_depth,
         options: format!(
-            "{}{} {} {}",
+            "{}{} {} {}{}",
             load_label(inputs.load),
             shutter_label(inputs.shutter),
             environment_label(inputs.environment),
-            filter_label(settings.filter, settings.filter_width)
+            filter_label(settings.filter, settings.filter_width),
+            guiding_label(settings.guiding)
         ),
         exposure: inputs.exposure,
         aovs: settings.aovs.label(),
+    }
+}
+
+/// Path guiding, with a leading space; nothing when off.
+fn guiding_label(guiding: Guiding) -> &'static str {
+    match guiding {
+        Guiding::On => " guiding=on",
+        Guiding::Off => "",
     }
 }
 

@@ -9,7 +9,7 @@ use glam::Vec3;
 
 use super::Renderer;
 use super::aov::Features;
-use super::bsdf::Bsdf;
+use super::guiding::{Guide, GuidedBsdf, Record};
 use super::sampler::Sampler;
 use super::sampling::power_heuristic;
 use super::surface::{Surface, surface_at};
@@ -47,6 +47,26 @@ enum Arrival {
     Scattered { pdf: f32 },
 }
 
+/// Whether a path draws directions from a guide, and whether it teaches one.
+#[derive(Clone, Copy)]
+pub enum PathGuiding<'a> {
+    /// BSDF sampling alone.
+    Off,
+    /// Directions from the BSDF and the guide.
+    Sample(&'a Guide),
+    /// As [`PathGuiding::Sample`], and the path's radiance is recorded into the guide.
+    Train(&'a Guide),
+}
+
+impl<'a> PathGuiding<'a> {
+    fn guide(self) -> Option<&'a Guide> {
+        match self {
+            PathGuiding::Off => None,
+            PathGuiding::Sample(g) | PathGuiding::Train(g) => Some(g),
+        }
+    }
+}
+
 /// The radiance estimate of one path and what it cost.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PathResult {
@@ -76,13 +96,36 @@ impl Renderer<'_> {
     /// `want_features` (which changes no random number, so not the radiance).
     pub fn trace_path_with_features(
         &self,
-        mut ray: Ray,
+        ray: Ray,
         sampler: &mut Sampler,
         max_depth: u32,
         strategy: Strategy,
         want_features: bool,
     ) -> PathResult {
+        self.trace_path_guided(
+            ray,
+            sampler,
+            max_depth,
+            strategy,
+            want_features,
+            PathGuiding::Off,
+        )
+    }
+
+    /// [`Renderer::trace_path_with_features`], drawing directions at rough vertices also
+    /// from a guide when `guiding` has one ([`super::guiding`]).
+    pub fn trace_path_guided(
+        &self,
+        mut ray: Ray,
+        sampler: &mut Sampler,
+        max_depth: u32,
+        strategy: Strategy,
+        want_features: bool,
+        guiding: PathGuiding,
+    ) -> PathResult {
         let mut result = PathResult::default();
+        // Guided vertices of a training path, completed when it ends.
+        let mut records: Vec<Record> = Vec::new();
         // Features still to be found: the path has not reached a rough surface yet.
         let mut seeking = want_features;
         // Distance along the path from the camera, for the depth layer.
@@ -224,6 +267,14 @@ impl Renderer<'_> {
                 -s.geometric_normal
             };
             let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo);
+            let (guide, region) = match guiding.guide() {
+                Some(g) if !bsdf.is_delta() => {
+                    let (distribution, region) = g.at(s.point);
+                    (Some(distribution), region)
+                }
+                _ => (None, 0),
+            };
+            let scatter = GuidedBsdf { bsdf: &bsdf, guide };
 
             // Sample a light for the next-event estimate. Punctual lights can only be found
             // this way, so even the BSDF-only estimator samples them.
@@ -232,11 +283,11 @@ impl Renderer<'_> {
             {
                 result.rays += 1;
                 result.radiance +=
-                    beta * self.direct_light(&bsdf, &s, ng, ns, wo, sampler, strategy);
+                    beta * self.direct_light(&scatter, &s, ng, ns, wo, sampler, strategy);
             }
 
             // Sample the BSDF to extend the path.
-            let Some(sample) = bsdf.sample(ns, wo, sampler.uniform2(), sampler.uniform()) else {
+            let Some(sample) = scatter.sample(ns, wo, sampler) else {
                 break;
             };
             let side = sample.wi.dot(ng);
@@ -244,6 +295,15 @@ impl Renderer<'_> {
                 break;
             }
             beta *= sample.weight;
+            if matches!(guiding, PathGuiding::Train(_)) && guide.is_some() && !sample.is_delta {
+                records.push(Guide::record(
+                    region,
+                    sample.wi,
+                    sample.pdf,
+                    beta,
+                    result.radiance,
+                ));
+            }
             if sample.is_transmission {
                 // Entering through the front face puts the path inside the volume.
                 medium =
@@ -284,6 +344,9 @@ impl Renderer<'_> {
                 break;
             }
         }
+        if let PathGuiding::Train(guide) = guiding {
+            guide.add_path(&records, result.radiance);
+        }
         result
     }
 
@@ -294,7 +357,7 @@ impl Renderer<'_> {
     #[allow(clippy::too_many_arguments)]
     fn direct_light(
         &self,
-        bsdf: &Bsdf,
+        bsdf: &GuidedBsdf,
         s: &Surface,
         ng: Vec3,
         ns: Vec3,
@@ -318,7 +381,7 @@ impl Renderer<'_> {
         if ls.radiance == Vec3::ZERO || (ng.dot(ls.wi) > 0.0) != (ns.dot(ls.wi) > 0.0) {
             return Vec3::ZERO;
         }
-        let f = bsdf.eval(ns, wo, ls.wi);
+        let f = bsdf.bsdf.eval(ns, wo, ls.wi);
         if f == Vec3::ZERO {
             return Vec3::ZERO;
         }

@@ -7,9 +7,12 @@ pub(crate) mod adaptive;
 pub(crate) mod aov;
 mod bsdf;
 mod camera;
+#[cfg(test)]
+mod chi_square;
 mod coverage;
 mod film;
 mod filter;
+mod guiding;
 mod integrator;
 mod lights;
 pub mod sampler;
@@ -23,6 +26,7 @@ pub use camera::RayGenerator;
 pub use coverage::{ViewCoverage, view_coverage};
 pub use film::{Film, Image, PixelAccumulator};
 pub use filter::{FilterKind, PixelFilter, profile as filter_profile};
+pub use guiding::Guiding;
 pub use integrator::{PathResult, Strategy};
 pub use lights::{EmissiveTriangles, LightSample, LightSet};
 
@@ -32,8 +36,9 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-use crate::accel::{SceneAccel, TopLevel};
+use crate::accel::{Ray, SceneAccel, TopLevel};
 use crate::scene::{Camera, Scene};
+use integrator::PathGuiding;
 use sampler::Sampler;
 use sampling::mix64;
 use surface::InstanceFrame;
@@ -72,6 +77,8 @@ pub struct RenderSettings {
     pub noise_threshold: Option<f32>,
     /// Stop starting passes once the next would end after this much time.
     pub time_limit: Option<Duration>,
+    /// Path guiding: trained before the first sample when on ([`guiding`]).
+    pub guiding: Guiding,
 }
 
 impl Default for RenderSettings {
@@ -88,6 +95,7 @@ impl Default for RenderSettings {
             aovs: AovSet::default(),
             noise_threshold: None,
             time_limit: None,
+            guiding: Guiding::Off,
         }
     }
 }
@@ -129,6 +137,31 @@ pub enum EarlyEnd {
 
 /// Makes the image of the samples taken so far, for a checkpoint.
 pub type ImageSoFar<'a> = &'a dyn Fn() -> (Image, RenderStats);
+
+/// How a pixel's camera rays are made: the camera, the pixel filter, and whether a
+/// shutter time is drawn.
+pub(crate) struct CameraSampling {
+    generator: RayGenerator,
+    filter: PixelFilter,
+    timed: bool,
+}
+
+impl CameraSampling {
+    /// The camera ray of the sample `sampler` stands at, through pixel (`x`, `y`). It draws
+    /// the filter offset, then a lens position only when there is a lens and a shutter
+    /// time only when something moves, so that other images keep their random streams.
+    fn ray(&self, x: usize, y: usize, sampler: &mut Sampler) -> Ray {
+        let at = self.filter.sample(sampler.uniform2());
+        let lens = if self.generator.has_lens() {
+            sampler.uniform2()
+        } else {
+            glam::Vec2::splat(0.5)
+        };
+        let time = if self.timed { sampler.uniform() } else { 0.0 };
+        let (px, py) = (x as f32 + at.x, y as f32 + at.y);
+        self.generator.generate_through_lens(px, py, lens, time)
+    }
+}
 
 /// A scene prepared for rendering.
 pub struct Renderer<'a> {
@@ -219,9 +252,11 @@ impl<'a> Renderer<'a> {
         on_pass: &mut dyn FnMut(ImageSoFar),
     ) -> (Image, RenderStats) {
         let start = Instant::now();
-        let generator = RayGenerator::new(camera, settings.width, settings.height);
-        let timed = camera.motion.is_some() || self.scene.has_moving_geometry();
-        let filter = PixelFilter::new(settings.filter, settings.filter_width);
+        let view = CameraSampling {
+            generator: RayGenerator::new(camera, settings.width, settings.height),
+            filter: PixelFilter::new(settings.filter, settings.filter_width),
+            timed: camera.motion.is_some() || self.scene.has_moving_geometry(),
+        };
         let width = settings.width as usize;
         let first_sample = settings.samples.start;
         let spp = settings.spp().max(1);
@@ -229,6 +264,8 @@ impl<'a> Renderer<'a> {
         let adaptive = settings
             .noise_threshold
             .map(|t| adaptive::Schedule::new(t, spp));
+        let guide = (settings.guiding == Guiding::On).then(|| self.train_guide(&view, settings));
+        let guiding = guide.as_ref().map_or(PathGuiding::Off, PathGuiding::Sample);
         let mut film = Film::new(
             settings.width,
             settings.height,
@@ -258,24 +295,14 @@ impl<'a> Renderer<'a> {
                         }
                         let pixel = (row.y * width + x) as u64;
                         let mut sampler = Sampler::for_sample(seed, pixel, sample);
-                        let at = filter.sample(sampler.uniform2());
-                        // A lens position only when there is a lens, so pinhole images keep
-                        // their random streams.
-                        let lens = if generator.has_lens() {
-                            sampler.uniform2()
-                        } else {
-                            glam::Vec2::splat(0.5)
-                        };
-                        // A shutter time only when something moves, likewise.
-                        let time = if timed { sampler.uniform() } else { 0.0 };
-                        let (px, py) = (x as f32 + at.x, row.y as f32 + at.y);
-                        let ray = generator.generate_through_lens(px, py, lens, time);
-                        let path = self.trace_path_with_features(
+                        let ray = view.ray(x, row.y as usize, &mut sampler);
+                        let path = self.trace_path_guided(
                             ray,
                             &mut sampler,
                             settings.max_depth,
                             settings.strategy,
                             wants_features,
+                            guiding,
                         );
                         rays += path.rays;
                         samples += 1;

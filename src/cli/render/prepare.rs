@@ -7,6 +7,7 @@ use anyhow::{Context, Result, anyhow, bail};
 
 use super::super::args::Args;
 use super::super::camera::{CameraPick, camera_label, image_size, with_depth_of_field};
+use super::super::choices::GuidingChoice;
 use super::super::environment::{
     EnvironmentSetting, EnvironmentSource, OBJECT_ON_NOTHING, apply_environment, studio_note,
 };
@@ -18,7 +19,7 @@ use crate::limits::check_memory;
 use crate::load::access::folder_of;
 use crate::load::load_scene_with;
 use crate::record::{sha256_file, sha256_files};
-use crate::render::{Film, RenderSettings, Strategy, view_coverage};
+use crate::render::{Film, Guiding, RenderSettings, Strategy, view_coverage};
 use crate::scene::{Camera, Scene};
 
 /// A scene ready to render, and how.
@@ -206,6 +207,18 @@ fn frame(
         aovs: plan.aovs,
         noise_threshold: sampling.noise_threshold,
         time_limit: sampling.time_limit.map(Duration::from_secs_f64),
+        guiding: guiding_for(sampling.guiding, scene),
     };
     Ok((camera, settings))
+}
+
+/// Whether to guide paths: as asked, or, for auto, when some material transmits light,
+/// where guiding pays (docs/benchmarks.md, "Path guiding").
+fn guiding_for(choice: GuidingChoice, scene: &Scene) -> Guiding {
+    let transmits = || scene.materials.iter().any(|m| m.pbr.transmission > 0.0);
+    match choice {
+        GuidingChoice::On => Guiding::On,
+        GuidingChoice::Auto if transmits() => Guiding::On,
+        GuidingChoice::Auto | GuidingChoice::Off => Guiding::Off,
+    }
 }

@@ -4,6 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use super::Bsdf;
+use crate::render::chi_square::sphere_z_score;
 use crate::render::sampling::Rng;
 use crate::scene::{Anisotropy, AnisotropyModel, Pbr, SheenModel};
 
@@ -104,21 +105,11 @@ fn materials() -> Vec<(&'static str, Pbr)> {
     ]
 }
 
-/// χ² test of [`Bsdf::sample`] against [`Bsdf::pdf`] over the whole sphere: bins of equal
-/// (cos θ, φ) area, expected counts from the pdf integrated over each bin, bins expected
-/// under 5 pooled (pbrt-v4's test). The statistic goes through the Wilson–Hilferty normal
-/// approximation; z > 4.5 (p ≈ 3·10⁻⁶ per test) fails.
+/// χ² test of [`Bsdf::sample`] against [`Bsdf::pdf`] over the whole sphere
+/// ([`crate::render::chi_square`]).
 #[test]
 fn sampling_matches_pdf_chi_square() {
-    const THETA: usize = 24;
-    const PHI: usize = 48;
     const SAMPLES: usize = 400_000;
-    let bin_of = |w: Vec3| {
-        let t = (((w.z + 1.0) * 0.5 * THETA as f32) as usize).min(THETA - 1);
-        let phi = w.y.atan2(w.x).rem_euclid(std::f32::consts::TAU);
-        let p = ((phi / std::f32::consts::TAU * PHI as f32) as usize).min(PHI - 1);
-        t * PHI + p
-    };
     let mut cases: Vec<(&str, Bsdf, bool)> = Vec::new();
     for (name, pbr) in materials() {
         cases.push((name, Bsdf::new(&pbr, true), true));
@@ -181,9 +172,10 @@ fn sampling_matches_pdf_chi_square() {
         for mu in [0.15f32, 0.6, 0.95] {
             let wo = direction(mu);
             let mut rng = Rng::new(17, (mu * 100.0) as u64);
-            let mut observed = vec![0f64; THETA * PHI];
-            for _ in 0..SAMPLES {
-                if let Some(s) = bsdf.sample(Vec3::Z, wo, rng.uniform2(), rng.uniform()) {
+            let (z, chi2, dof) = sphere_z_score(
+                SAMPLES,
+                || {
+                    let s = bsdf.sample(Vec3::Z, wo, rng.uniform2(), rng.uniform())?;
                     assert!(!s.is_delta && s.pdf > 0.0, "{name}: {s:?}");
                     let pdf = bsdf.pdf(Vec3::Z, wo, s.wi);
                     assert!(
@@ -191,61 +183,16 @@ fn sampling_matches_pdf_chi_square() {
                         "{name}: sample pdf {} vs pdf() {pdf}",
                         s.pdf
                     );
-                    observed[bin_of(s.wi)] += 1.0;
-                }
-            }
-            // Expected counts: the pdf integrated over each bin on a 16×16 sub-grid (fine
-            // enough for the sharpest lobe here, α = 0.04).
-            let sub = 16;
-            let mut expected = vec![0f64; THETA * PHI];
-            let bin_area = 4.0 * std::f64::consts::PI / (THETA * PHI) as f64;
-            for t in 0..THETA {
-                for p in 0..PHI {
-                    let mut sum = 0.0f64;
-                    for i in 0..sub {
-                        for j in 0..sub {
-                            let z = -1.0
-                                + 2.0 * (t as f32 + (i as f32 + 0.5) / sub as f32) / THETA as f32;
-                            let phi = std::f32::consts::TAU
-                                * (p as f32 + (j as f32 + 0.5) / sub as f32)
-                                / PHI as f32;
-                            let r = (1.0 - z * z).max(0.0).sqrt();
-                            let wi = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-                            sum += f64::from(bsdf.pdf(Vec3::Z, wo, wi));
-                        }
-                    }
-                    expected[t * PHI + p] = sum / (sub * sub) as f64 * bin_area * SAMPLES as f64;
-                }
-            }
-            let (chi2, dof) = pooled_chi_square(&observed, &expected);
-            let k = dof as f64;
-            let z = ((chi2 / k).cbrt() - (1.0 - 2.0 / (9.0 * k))) / (2.0 / (9.0 * k)).sqrt();
+                    Some(s.wi)
+                },
+                |wi| bsdf.pdf(Vec3::Z, wo, wi),
+            );
             assert!(
                 z < 4.5,
                 "{name}, μo {mu}, front {front}: χ² {chi2:.1} with {dof} dof (z {z:.2})"
             );
         }
     }
-}
-
-/// χ² over bins with expected count ≥ 5, the rest pooled into one bin.
-fn pooled_chi_square(observed: &[f64], expected: &[f64]) -> (f64, usize) {
-    let (mut chi2, mut dof) = (0.0, 0usize);
-    let (mut pooled_o, mut pooled_e) = (0.0, 0.0);
-    for (&o, &e) in observed.iter().zip(expected) {
-        if e < 5.0 {
-            pooled_o += o;
-            pooled_e += e;
-        } else {
-            chi2 += (o - e) * (o - e) / e;
-            dof += 1;
-        }
-    }
-    if pooled_e >= 5.0 {
-        chi2 += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
-        dof += 1;
-    }
-    (chi2, dof.saturating_sub(1).max(1))
 }
 
 /// E[weight] of [`Bsdf::sample`] is the directional albedo.

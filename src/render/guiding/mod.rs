@@ -1,0 +1,237 @@
+//! Path guiding: where unidirectional sampling finds light badly — a diffuse surface lit
+//! through glass, a room lit through a window — the incident radiance learned in short
+//! training passes proposes directions beside the BSDF (Müller, Gross & Novák 2017,
+//! "Practical Path Guiding for Efficient Light-Transport Simulation").
+//!
+//! The guide is an SD-tree: a binary tree over the scene's bounds (halving x, y, z in
+//! turn) whose leaves, the regions, each hold a directional [`quadtree`]. Training passes
+//! trace paths that draw from the guide as it stands and record, at every vertex, the
+//! radiance that reached it; after each pass the regions that gathered many records are
+//! split and every quadtree is rebuilt from its energy (§3–4 of the paper).
+//!
+//! The project's guarantees hold: training samples come from their own random streams,
+//! keyed by (seed, pixel, training index) like every other sample, and the energies are
+//! summed as integers, so the trained guide — and the image — are the same for any thread
+//! count, and every process of a split render trains the same guide before taking its
+//! range of samples, so the ranges still merge exactly.
+
+mod mixture;
+mod quadtree;
+mod train;
+
+pub use mixture::GuidedBsdf;
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use glam::Vec3;
+
+use crate::geometry::Aabb;
+use quadtree::{Distribution, Histogram};
+
+/// Whether paths are guided.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Guiding {
+    /// Paths sample BSDFs only.
+    #[default]
+    Off,
+    /// A guide is trained before the first sample and then proposes directions.
+    On,
+}
+
+/// A region splits once one pass gave it more records than this times √(2^pass) (the
+/// paper's c = 12,000, lowered for the smaller images a path tracer's previews have).
+const SPLIT_RECORDS: f64 = 4000.0;
+
+/// Deepest level of the spatial tree.
+const MAX_SPATIAL_DEPTH: u32 = 24;
+
+/// One leaf of the spatial tree: the distribution paths draw from, the histogram that
+/// gathers the current pass's records, and how many records it took.
+#[derive(Debug)]
+struct Region {
+    distribution: Distribution,
+    histogram: Histogram,
+    records: AtomicU64,
+}
+
+impl Region {
+    fn new(distribution: Distribution) -> Region {
+        Region {
+            histogram: distribution.refined(),
+            distribution,
+            records: AtomicU64::new(0),
+        }
+    }
+}
+
+/// A node of the spatial tree: an inner node halves its box along `axis`; a leaf names
+/// its region and its depth.
+#[derive(Clone, Copy, Debug)]
+enum SpatialNode {
+    Inner { axis: u8, children: [u32; 2] },
+    Leaf { region: u32, depth: u32 },
+}
+
+/// The trained (or training) guide of a scene.
+#[derive(Debug)]
+pub struct Guide {
+    bounds: Aabb,
+    nodes: Vec<SpatialNode>,
+    regions: Vec<Region>,
+}
+
+/// Where a guided vertex records what reached it, kept along the path until its end.
+#[derive(Clone, Copy, Debug)]
+pub struct Record {
+    region: u32,
+    /// The direction the path left the vertex in.
+    direction: Vec3,
+    /// The density it was drawn with (the mixture's).
+    pdf: f32,
+    /// The throughput after the bounce at the vertex.
+    beta: Vec3,
+    /// The path's radiance before anything the bounce found.
+    radiance_before: Vec3,
+}
+
+impl Guide {
+    /// An untrained guide over `bounds`: one region, uniform.
+    pub fn new(bounds: Aabb) -> Guide {
+        let extent = (bounds.max - bounds.min).max_element().max(1e-3);
+        let pad = Vec3::splat(extent * 1e-3);
+        Guide {
+            bounds: Aabb {
+                min: bounds.min - pad,
+                max: bounds.max + pad,
+            },
+            nodes: vec![SpatialNode::Leaf {
+                region: 0,
+                depth: 0,
+            }],
+            regions: vec![Region::new(Distribution::uniform())],
+        }
+    }
+
+    /// The region holding `point` (points outside the bounds go to the nearest region).
+    fn region_index(&self, point: Vec3) -> u32 {
+        let mut p = ((point - self.bounds.min) / (self.bounds.max - self.bounds.min))
+            .clamp(Vec3::ZERO, Vec3::splat(1.0 - f32::EPSILON));
+        let mut node = 0usize;
+        loop {
+            match self.nodes[node] {
+                SpatialNode::Leaf { region, .. } => return region,
+                SpatialNode::Inner { axis, children } => {
+                    let a = axis as usize;
+                    let upper = p[a] >= 0.5;
+                    p[a] = (p[a] * 2.0 - f32::from(u8::from(upper))).clamp(0.0, 1.0 - f32::EPSILON);
+                    node = children[usize::from(upper)] as usize;
+                }
+            }
+        }
+    }
+
+    /// The directional distribution at `point`, with the region's index for recording.
+    pub fn at(&self, point: Vec3) -> (&Distribution, u32) {
+        let region = self.region_index(point);
+        (&self.regions[region as usize].distribution, region)
+    }
+
+    /// A record of a bounce at a vertex of `region`, to be completed when the path ends.
+    pub fn record(
+        region: u32,
+        direction: Vec3,
+        pdf: f32,
+        beta: Vec3,
+        radiance_before: Vec3,
+    ) -> Record {
+        Record {
+            region,
+            direction,
+            pdf,
+            beta,
+            radiance_before,
+        }
+    }
+
+    /// Adds what each recorded vertex of a finished path received: the radiance gathered
+    /// after its bounce, divided by the throughput up to it (an estimate of the incident
+    /// radiance from its direction) and by the density of that direction, so that a
+    /// quadrant's sum estimates its integral of incident radiance (the paper's §3.3).
+    pub fn add_path(&self, records: &[Record], radiance: Vec3) {
+        for r in records {
+            let gained = radiance - r.radiance_before;
+            let incident = Vec3::select(r.beta.cmpgt(Vec3::ZERO), gained / r.beta, Vec3::ZERO);
+            let region = &self.regions[r.region as usize];
+            region.records.fetch_add(1, Ordering::Relaxed);
+            region
+                .histogram
+                .record(r.direction, incident.element_sum() / 3.0 / r.pdf);
+        }
+    }
+
+    /// Ends training pass `pass` (from 0): every region samples what it gathered from now
+    /// on, regions with many records are split (their halves start from the same
+    /// distribution), and fresh histograms are made, refined where energy was found.
+    pub fn end_pass(&mut self, pass: u32) {
+        for region in &mut self.regions {
+            let learned = region.histogram.freeze();
+            if !learned.is_uniform() {
+                region.distribution = learned;
+            }
+        }
+        let limit = SPLIT_RECORDS * 2f64.powf(f64::from(pass) * 0.5);
+        let mut node = 0;
+        while node < self.nodes.len() {
+            if let SpatialNode::Leaf { region, depth } = self.nodes[node] {
+                self.split_if_full(node, region, depth, limit);
+            }
+            node += 1;
+        }
+        for region in &mut self.regions {
+            region.histogram = region.distribution.refined();
+            region.records.store(0, Ordering::Relaxed);
+        }
+    }
+
+    /// Splits leaf `node` (of region `region`) in two along the axis after its parent's,
+    /// halving its record count, while the count is above `limit`.
+    fn split_if_full(&mut self, node: usize, region: u32, depth: u32, limit: f64) {
+        let records = self.regions[region as usize]
+            .records
+            .load(Ordering::Relaxed);
+        if (records as f64) <= limit || depth >= MAX_SPATIAL_DEPTH {
+            return;
+        }
+        let axis = (depth % 3) as u8;
+        let half = records / 2;
+        let twin = self.regions.len() as u32;
+        let distribution = self.regions[region as usize].distribution.clone();
+        self.regions.push(Region::new(distribution));
+        self.regions[region as usize]
+            .records
+            .store(half, Ordering::Relaxed);
+        self.regions[twin as usize]
+            .records
+            .store(half, Ordering::Relaxed);
+        let first = self.nodes.len() as u32;
+        let depth = depth + 1;
+        self.nodes.push(SpatialNode::Leaf { region, depth });
+        self.nodes.push(SpatialNode::Leaf {
+            region: twin,
+            depth,
+        });
+        self.nodes[node] = SpatialNode::Inner {
+            axis,
+            children: [first, first + 1],
+        };
+        // The halves are judged by the loop in `end_pass`, which reaches them later.
+    }
+
+    /// Regions (leaves of the spatial tree).
+    pub fn region_count(&self) -> usize {
+        self.regions.len()
+    }
+}
+
+#[cfg(test)]
+mod tests;
