@@ -6,7 +6,7 @@ mod shapes;
 
 use glam::{Affine3A, Vec3};
 use gridtrace::load::load_scene;
-use gridtrace::render::{Image, RenderSettings, Renderer, Strategy};
+use gridtrace::render::{Guiding, Image, RenderSettings, Renderer, Strategy};
 use gridtrace::scene::{
     Camera, Instance, Material, Motion, Pbr, Scene, SceneBuilder, SheenModel, TimeSlice,
 };
@@ -185,6 +185,19 @@ fn estimate(
     size: u32,
     spp: u32,
 ) -> (Vec<f64>, Vec<f64>) {
+    estimate_guided(scene, camera, strategy, Guiding::Off, seeds, size, spp)
+}
+
+/// [`estimate`], guided or not.
+fn estimate_guided(
+    scene: &Scene,
+    camera: &Camera,
+    strategy: Strategy,
+    guiding: Guiding,
+    seeds: u64,
+    size: u32,
+    spp: u32,
+) -> (Vec<f64>, Vec<f64>) {
     let renderer = Renderer::new(scene);
     let runs: Vec<Vec<f64>> = (0..seeds)
         .map(|seed| {
@@ -195,6 +208,7 @@ fn estimate(
                 max_depth: 8,
                 seed,
                 strategy,
+                guiding,
                 ..RenderSettings::default()
             };
             block_means(&renderer.render(camera, &settings, &|| {}).0, size / 4)
@@ -265,6 +279,27 @@ fn light_sampling_bsdf_sampling_and_mis_converge_to_the_same_image() {
             total(&mis),
             total(&bsdf)
         );
+    }
+}
+
+/// Guided paths converge to the unguided image, whichever way direct light is found: the
+/// guide changes where directions come from, and every estimator weighs them by the
+/// mixture's density.
+#[test]
+fn guided_light_sampling_bsdf_sampling_and_mis_converge_to_the_unguided_image() {
+    for contents in [Contents::Ideal, Contents::Glossy] {
+        let scene = test_room(contents);
+        let camera = camera_at(3.4, 40.0);
+        let unguided = estimate(&scene, &camera, Strategy::Mis, SEEDS, 32, 16);
+        let name = format!("{contents:?}");
+        for strategy in [Strategy::Mis, Strategy::LightOnly, Strategy::BsdfOnly] {
+            let guided = estimate_guided(&scene, &camera, strategy, Guiding::On, SEEDS, 32, 16);
+            assert_agree(
+                &format!("{name}: unguided MIS vs guided {strategy:?}"),
+                &unguided,
+                &guided,
+            );
+        }
     }
 }
 
@@ -400,6 +435,12 @@ fn same_seed_same_image_whatever_the_thread_count() {
     };
     let one = render(1, &settings);
     let three = render(3, &settings);
+    let guided = RenderSettings {
+        guiding: Guiding::On,
+        ..settings.clone()
+    };
+    let guided_one = render(1, &guided);
+    let guided_three = render(3, &guided);
     let bits = |image: &Image| {
         image
             .pixels
@@ -412,6 +453,12 @@ fn same_seed_same_image_whatever_the_thread_count() {
         bits(&three),
         "1 and 3 threads give different images"
     );
+    assert_eq!(
+        bits(&guided_one),
+        bits(&guided_three),
+        "guided, 1 and 3 threads give different images"
+    );
+    assert_ne!(bits(&one), bits(&guided_one), "guiding changes nothing");
     assert!(one.mean().max_element() > 0.0);
     let other = render(
         2,

@@ -16,7 +16,7 @@ use gridtrace::load::load_scene;
 use gridtrace::output::merge::{MERGE_TOLERANCE, MergeError, merge_files, read_part};
 use gridtrace::output::{ViewTransform, write_image, write_image_with_record};
 use gridtrace::record::{RenderIdentity, RenderRecord};
-use gridtrace::render::{Image, RenderSettings, Renderer};
+use gridtrace::render::{Guiding, Image, RenderSettings, Renderer};
 use gridtrace::scene::Camera;
 
 const SIZE: u32 = 32;
@@ -49,17 +49,29 @@ fn record(samples: Range<u32>, seed: u64) -> RenderRecord {
     }
 }
 
-/// Renders samples `range` of the Cornell box.
-fn render(renderer: &Renderer, camera: &Camera, range: Range<u32>, seed: u64) -> Image {
+/// Renders samples `range` of the Cornell box, guided or not.
+fn render_guided(
+    renderer: &Renderer,
+    camera: &Camera,
+    range: Range<u32>,
+    seed: u64,
+    guiding: Guiding,
+) -> Image {
     let settings = RenderSettings {
         width: SIZE,
         height: SIZE,
         samples: range.clone(),
         max_depth: 8,
         seed,
+        guiding,
         ..RenderSettings::default()
     };
     renderer.render(camera, &settings, &|| {}).0
+}
+
+/// Renders samples `range` of the Cornell box.
+fn render(renderer: &Renderer, camera: &Camera, range: Range<u32>, seed: u64) -> Image {
+    render_guided(renderer, camera, range, seed, Guiding::Off)
 }
 
 /// The largest difference between two images relative to the larger value, and whether
@@ -127,6 +139,39 @@ fn merged_parts_equal_one_render_for_one_two_and_four_parts() {
     // The comparison has teeth: another seed's render is nowhere near the bound.
     let other = render(&renderer, &camera, 0..SPP, 4);
     assert!(relative_difference(&other, &whole) > 1000.0 * MERGE_TOLERANCE);
+}
+
+/// Every process of a guided split render trains the same guide, whatever its range, so
+/// guided parts merge to the guided whole as unguided ones do.
+#[test]
+fn guided_parts_merge_to_the_guided_whole() {
+    let scene = load_scene(&cornell_box()).unwrap().scene;
+    let camera = scene.cameras[0].clone();
+    let renderer = Renderer::new(&scene);
+    let whole = render_guided(&renderer, &camera, 0..SPP, 3, Guiding::On);
+    let dir = tempfile::tempdir().unwrap();
+    let mut paths = Vec::new();
+    for range in [0..5, 5..SPP] {
+        let part = render_guided(&renderer, &camera, range.clone(), 3, Guiding::On);
+        let path = dir.path().join(format!("part-{}.exr", range.start));
+        write_image_with_record(
+            &path,
+            &part,
+            Some(&record(range, 3)),
+            ViewTransform::Standard,
+        )
+        .unwrap();
+        paths.push(path);
+    }
+    let (merged, _) = merge_files(&paths, Some(0..SPP)).unwrap();
+    let difference = relative_difference(&merged, &whole);
+    assert!(
+        difference <= MERGE_TOLERANCE,
+        "{difference:e} > {MERGE_TOLERANCE:e}"
+    );
+    // Guiding changed the samples: the comparison is of guided renders.
+    let unguided = render(&renderer, &camera, 0..SPP, 3);
+    assert!(relative_difference(&unguided, &whole) > 1000.0 * MERGE_TOLERANCE);
 }
 
 /// Writes a part with `record` and returns its path.

@@ -170,9 +170,9 @@ pub struct SamplingArgs {
     pub time_limit: Option<f64>,
 
     /// Path guiding: a guide of the incident light, trained in 8 samples per pixel before
-    /// the first sample, proposes half the directions at rough surfaces. It pays where
-    /// light arrives through glass; auto turns it on when some material transmits light.
-    #[arg(long, value_enum, value_name = "WHEN", default_value = "auto")]
+    /// the first sample, proposes half the directions at rough surfaces. Off by default:
+    /// it does not yet pay on the scenes measured (docs/benchmarks.md, "Path guiding").
+    #[arg(long, value_enum, value_name = "WHEN", default_value = "off")]
     pub guiding: GuidingChoice,
 
     /// Pixel filter, sampled by filter importance sampling (each sample lands in one pixel,

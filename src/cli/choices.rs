@@ -43,12 +43,10 @@ pub enum SoftFalloffChoice {
 /// `--guiding`: whether paths are guided ([`crate::render::Guiding`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum GuidingChoice {
-    /// On when some material transmits light (glass, a window, a lamp shade).
-    #[default]
-    Auto,
-    /// Always.
+    /// Paths are guided.
     On,
-    /// Never.
+    /// Paths sample BSDFs alone.
+    #[default]
     Off,
 }
 

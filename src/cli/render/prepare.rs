@@ -207,18 +207,15 @@ fn frame(
         aovs: plan.aovs,
         noise_threshold: sampling.noise_threshold,
         time_limit: sampling.time_limit.map(Duration::from_secs_f64),
-        guiding: guiding_for(sampling.guiding, scene),
+        guiding: guiding_for(sampling.guiding),
     };
     Ok((camera, settings))
 }
 
-/// Whether to guide paths: as asked, or, for auto, when some material transmits light,
-/// where guiding pays (docs/benchmarks.md, "Path guiding").
-fn guiding_for(choice: GuidingChoice, scene: &Scene) -> Guiding {
-    let transmits = || scene.materials.iter().any(|m| m.pbr.transmission > 0.0);
+/// Whether to guide paths, as asked.
+fn guiding_for(choice: GuidingChoice) -> Guiding {
     match choice {
         GuidingChoice::On => Guiding::On,
-        GuidingChoice::Auto if transmits() => Guiding::On,
-        GuidingChoice::Auto | GuidingChoice::Off => Guiding::Off,
+        GuidingChoice::Off => Guiding::Off,
     }
 }
