@@ -295,7 +295,7 @@ impl<'a> Renderer<'a> {
                         }
                         let pixel = (row.y * width + x) as u64;
                         let mut sampler = Sampler::for_sample(seed, pixel, sample);
-                        let ray = view.ray(x, row.y as usize, &mut sampler);
+                        let ray = view.ray(x, row.y, &mut sampler);
                         let path = self.trace_path_guided(
                             ray,
                             &mut sampler,
