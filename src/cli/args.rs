@@ -169,9 +169,9 @@ pub struct SamplingArgs {
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub time_limit: Option<f64>,
 
-    /// Path guiding: a guide of the incident light, trained in 8 samples per pixel before
-    /// the first sample, proposes half the directions at rough surfaces. Off by default:
-    /// it does not yet pay on the scenes measured (docs/benchmarks.md, "Path guiding").
+    /// Path guiding: a guide of the incident light, trained on the image's first 16 samples
+    /// per pixel, proposes half the directions at diffuse surfaces. Off by default: it does
+    /// not yet pay on the scenes measured (docs/benchmarks.md, "Path guiding").
     #[arg(long, value_enum, value_name = "WHEN", default_value = "off")]
     pub guiding: GuidingChoice,
 

@@ -268,7 +268,7 @@ impl Renderer<'_> {
             };
             let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo);
             let (guide, region) = match guiding.guide() {
-                Some(g) if !bsdf.is_delta() => {
+                Some(g) if bsdf.is_guidable() => {
                     let (distribution, region) = g.at(s.point);
                     (Some(distribution), region)
                 }

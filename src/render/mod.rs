@@ -38,7 +38,7 @@ use rayon::prelude::*;
 
 use crate::accel::{Ray, SceneAccel, TopLevel};
 use crate::scene::{Camera, Scene};
-use integrator::PathGuiding;
+use guiding::{Guide, guiding_at};
 use sampler::Sampler;
 use sampling::mix64;
 use surface::InstanceFrame;
@@ -77,7 +77,7 @@ pub struct RenderSettings {
     pub noise_threshold: Option<f32>,
     /// Stop starting passes once the next would end after this much time.
     pub time_limit: Option<Duration>,
-    /// Path guiding: trained before the first sample when on ([`guiding`]).
+    /// Path guiding: trained on the first samples when on ([`guiding`]).
     pub guiding: Guiding,
 }
 
@@ -264,8 +264,11 @@ impl<'a> Renderer<'a> {
         let adaptive = settings
             .noise_threshold
             .map(|t| adaptive::Schedule::new(t, spp));
-        let guide = (settings.guiding == Guiding::On).then(|| self.train_guide(&view, settings));
-        let guiding = guide.as_ref().map_or(PathGuiding::Off, PathGuiding::Sample);
+        let mut guide = (settings.guiding == Guiding::On).then(|| {
+            let mut guide = Guide::new(self.scene.bounds());
+            self.train_guide_before(&view, settings, &mut guide, first_sample);
+            guide
+        });
         let mut film = Film::new(
             settings.width,
             settings.height,
@@ -283,6 +286,7 @@ impl<'a> Renderer<'a> {
         while stats.spp < spp {
             let pass_start = Instant::now();
             let sample = first_sample + stats.spp;
+            let guiding = guiding_at(guide.as_ref(), sample);
             let (rays, samples) = film
                 .rows()
                 .into_par_iter()
@@ -315,6 +319,9 @@ impl<'a> Renderer<'a> {
             stats.rays += rays;
             stats.samples += samples;
             stats.spp += 1;
+            if let Some(guide) = &mut guide {
+                guide.after_sample(sample);
+            }
             if stats.spp == spp {
                 break;
             }

@@ -31,7 +31,7 @@ from mathutils import Vector
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import make_cornell  # noqa: E402  (shares the Cornell scene builders)
 from make_cornell import (  # noqa: E402
-    box, build_cornell_box, build_cornell_spheres, export, principled, quad, reset, sphere,
+    box, build_cornell_box, build_cornell_spheres, export, mesh_object, principled, quad, reset, sphere,
 )
 
 ROOT = make_cornell.ROOT
@@ -283,6 +283,36 @@ def build_material_details(scene):
     sphere("MetalBall", rough, 0.5, (1.5, 0.0, 0.5))
 
 
+def build_window_room(scene):
+    """A closed room lit only through a glazed window: a bright panel outside faces a pane of
+    clear glass (a 1 cm slab) set in the far wall. Next-event estimation cannot see the
+    panel through the glass, so every path that lights the room crosses the pane by a BSDF
+    bounce — the interior that path guiding is for."""
+    white = principled("Wall", (0.8, 0.8, 0.8))
+    floor = principled("Floor", (0.6, 0.5, 0.4))
+    glass = principled("Pane", (1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5)
+    sky = principled("Sky", (0.0, 0.0, 0.0), emission=(0.9, 0.95, 1.0), strength=6.0)
+    w, d, h = 2.0, 2.0, 2.5
+    x0, x1, z0, z1 = -0.7, 0.7, 0.9, 1.9
+    quad("Floor", [(-w, -d, 0), (w, -d, 0), (w, d, 0), (-w, d, 0)], floor)
+    quad("Ceiling", [(-w, -d, h), (-w, d, h), (w, d, h), (w, -d, h)], white)
+    quad("LeftWall", [(-w, -d, 0), (-w, d, 0), (-w, d, h), (-w, -d, h)], white)
+    quad("RightWall", [(w, -d, 0), (w, -d, h), (w, d, h), (w, d, 0)], white)
+    quad("NearWall", [(-w, -d, 0), (-w, -d, h), (w, -d, h), (w, -d, 0)], white)
+    # The far wall (y = d, facing -y) around the window opening, in four pieces.
+    pieces = [
+        [(-w, d, 0), (w, d, 0), (w, d, z0), (-w, d, z0)],
+        [(-w, d, z1), (w, d, z1), (w, d, h), (-w, d, h)],
+        [(-w, d, z0), (x0, d, z0), (x0, d, z1), (-w, d, z1)],
+        [(x1, d, z0), (w, d, z0), (w, d, z1), (x1, d, z1)],
+    ]
+    mesh_object("FarWall", [v for q in pieces for v in q], [(4 * i, 4 * i + 1, 4 * i + 2, 4 * i + 3) for i in range(4)], white)
+    pane = box("Pane", glass, (x1 - x0, 0.01, z1 - z0), (0.0, d, z0), 0.0)
+    pane.location = (0.0, d, z0)
+    quad("Sky", [(-4, d + 3, -1), (4, d + 3, -1), (4, d + 3, 5), (-4, d + 3, 5)], sky)
+    add_camera(scene, (-1.2, -1.8, 1.6), (0.4, 1.0, 0.5), 70.0)
+
+
 # Scenes also exported through Blender's USD exporter, to check that both exports render alike.
 USD_EXPORTS = {"punctual_lights", "textured"}
 
@@ -294,6 +324,7 @@ SCENE_TABLE = {
     "coloured_lights": (build_coloured_lights, SCENES, 4096),
     "punctual_lights": (build_punctual_lights, SCENES, 4096),
     "textured": (build_textured, SCENES, 4096),
+    "window_room": (build_window_room, SCENES, 4096),
     "material_details": (build_material_details, SCENES, 0),
 }
 

@@ -356,6 +356,13 @@ impl Bsdf {
     }
 
     /// True when the cosine strategy (Lambertian base, Charlie sheen) has anything to draw.
+    /// True when the BSDF scatters diffusely (a Lambertian base or sheen beneath the coat):
+    /// where path guiding pays, since a narrow glossy or glass lobe already samples its
+    /// directions well.
+    pub fn is_guidable(&self) -> bool {
+        self.has_cosine_lobes()
+    }
+
     fn has_cosine_lobes(&self) -> bool {
         self.diffuse.max_element() > 0.0 || self.sheen.is_some_and(|s| !s.over_coat())
     }

@@ -4,7 +4,7 @@
 //! Veach 1997 §9.2.4, as the paper's §5 combines them). Next-event estimation sees the
 //! mixture's density too, so its MIS weights stay right.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::quadtree::Distribution;
 use crate::render::bsdf::{Bsdf, BsdfSample};
@@ -32,18 +32,18 @@ impl GuidedBsdf<'_> {
         }
     }
 
-    /// Draws an incident direction. Without a guide it takes the BSDF's numbers alone
-    /// (direction pair, then lobe choice), so unguided paths keep their random streams;
-    /// with one, a number choosing the strategy comes first.
+    /// Draws an incident direction from the BSDF's numbers (direction pair, then lobe
+    /// choice). With a guide, the pair's first number also chooses the strategy and is
+    /// rescaled within the share chosen, so that each strategy's directions stay
+    /// stratified over the pixel's samples, as the BSDF's alone are.
     pub fn sample(&self, n: Vec3, wo: Vec3, sampler: &mut Sampler) -> Option<BsdfSample> {
-        let Some(guide) = self.guide else {
-            return self
-                .bsdf
-                .sample(n, wo, sampler.uniform2(), sampler.uniform());
-        };
-        let choice = sampler.uniform();
         let (u, u_lobe) = (sampler.uniform2(), sampler.uniform());
-        if choice < GUIDE_FRACTION {
+        let Some(guide) = self.guide else {
+            return self.bsdf.sample(n, wo, u, u_lobe);
+        };
+        let below_one = 1.0 - f32::EPSILON;
+        if u.x < GUIDE_FRACTION {
+            let u = Vec2::new((u.x / GUIDE_FRACTION).min(below_one), u.y);
             let (wi, guide_pdf) = guide.sample(u);
             let f = self.bsdf.eval(n, wo, wi);
             let pdf = mix(guide_pdf, self.bsdf.pdf(n, wo, wi));
@@ -58,7 +58,8 @@ impl GuidedBsdf<'_> {
                 is_transmission: wi.dot(n) < 0.0,
             });
         }
-        let sample = self.bsdf.sample(n, wo, u, u_lobe)?;
+        let rest = ((u.x - GUIDE_FRACTION) / (1.0 - GUIDE_FRACTION)).clamp(0.0, below_one);
+        let sample = self.bsdf.sample(n, wo, Vec2::new(rest, u.y), u_lobe)?;
         if sample.is_delta {
             // The guide cannot draw a delta lobe's direction: only the BSDF's share counts.
             let share = 1.0 - GUIDE_FRACTION;

@@ -4,22 +4,23 @@
 //! "Practical Path Guiding for Efficient Light-Transport Simulation").
 //!
 //! The guide is an SD-tree: a binary tree over the scene's bounds (halving x, y, z in
-//! turn) whose leaves, the regions, each hold a directional [`quadtree`]. Training passes
-//! trace paths that draw from the guide as it stands and record, at every vertex, the
-//! radiance that reached it; after each pass the regions that gathered many records are
-//! split and every quadtree is rebuilt from its energy (§3–4 of the paper).
+//! turn) whose leaves, the regions, each hold a directional [`quadtree`]. The image's
+//! first samples are the training passes ([`train`]): their paths draw from the guide as
+//! it stands and record, at every guided vertex, the radiance that reached it; after each
+//! pass the regions that gathered many records are split and every quadtree is rebuilt
+//! from its energy (§3–4 of the paper).
 //!
-//! The project's guarantees hold: training samples come from their own random streams,
-//! keyed by (seed, pixel, training index) like every other sample, and the energies are
-//! summed as integers, so the trained guide — and the image — are the same for any thread
-//! count, and every process of a split render trains the same guide before taking its
-//! range of samples, so the ranges still merge exactly.
+//! The project's guarantees hold: energies are summed as integers, so the guide — and the
+//! image — are the same for any thread count; and a process rendering a later range of
+//! samples first traces the training samples before it, so every sample is the same
+//! whichever process renders it, and split renders still merge exactly.
 
 mod mixture;
 mod quadtree;
 mod train;
 
 pub use mixture::GuidedBsdf;
+pub use train::guiding_at;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -39,8 +40,10 @@ pub enum Guiding {
 }
 
 /// A region splits once one pass gave it more records than this times √(2^pass) (the
-/// paper's c = 12,000, lowered for the smaller images a path tracer's previews have).
-const SPLIT_RECORDS: f64 = 4000.0;
+/// paper's c = 12,000, lowered for the smaller images and shorter training here: 1,000
+/// lowered the error on the lamp shade by a fifth against 4,000, measured with
+/// tools/dev/guiding_efficiency.py).
+const SPLIT_RECORDS: f64 = 1000.0;
 
 /// Deepest level of the spatial tree.
 const MAX_SPATIAL_DEPTH: u32 = 24;
@@ -225,11 +228,6 @@ impl Guide {
             children: [first, first + 1],
         };
         // The halves are judged by the loop in `end_pass`, which reaches them later.
-    }
-
-    /// Regions (leaves of the spatial tree).
-    pub fn region_count(&self) -> usize {
-        self.regions.len()
     }
 }
 

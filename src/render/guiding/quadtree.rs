@@ -9,7 +9,7 @@
 //! the next pass's histogram, subdivided where the distribution holds much energy.
 
 use std::f32::consts::PI;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
 use glam::{Vec2, Vec3};
 
@@ -23,6 +23,11 @@ const MAX_RECORD: f64 = (1u64 << 24) as f64;
 /// A quadrant of a node whose energy is above this fraction of the total is subdivided
 /// (the paper's ρ = 0.01).
 const SUBDIVIDE_FRACTION: f64 = 0.01;
+
+/// A quadrant is subdivided only when it took at least this many records in the pass, so
+/// that cells stay larger than the records can resolve: finer cells would be empty by
+/// chance and leave holes in the distribution.
+const MIN_RECORDS: f64 = 64.0;
 
 /// Deepest level of the quadtree (the paper's 20).
 const MAX_DEPTH: u32 = 20;
@@ -62,12 +67,13 @@ pub fn to_sphere(p: Vec2) -> Vec3 {
 /// Solid-angle density of a density on the unit square: the map has constant Jacobian 4π.
 pub const SQUARE_TO_SPHERE: f32 = 1.0 / (4.0 * PI);
 
-/// One node of a frozen quadtree: the child of each quadrant ([`LEAF`] for none) and its
-/// share of the node's energy.
+/// One node of a frozen quadtree: the child of each quadrant ([`LEAF`] for none), its
+/// share of the node's energy and the records that fell in it.
 #[derive(Clone, Debug)]
 struct Node {
     children: [u32; 4],
     energy: [f32; 4],
+    records: [u32; 4],
 }
 
 /// A distribution over the sphere, sampled in proportion to the energy recorded in each
@@ -84,6 +90,7 @@ impl Distribution {
             nodes: vec![Node {
                 children: [LEAF; 4],
                 energy: [0.0; 4],
+                records: [0; 4],
             }],
         }
     }
@@ -160,20 +167,21 @@ impl Distribution {
     }
 
     /// An empty histogram for the next pass: this tree's quadrants subdivided where they
-    /// hold more than [`SUBDIVIDE_FRACTION`] of the energy, and merged where they hold
-    /// less (the paper's §4: a leaf with much energy is split, and its quarters, which get
-    /// a quarter each, are judged again).
+    /// hold more than [`SUBDIVIDE_FRACTION`] of the energy and [`MIN_RECORDS`] records, and
+    /// merged where they hold less (the paper's §4: a leaf with much energy is split, and
+    /// its quarters, which get a quarter each, are judged again).
     pub fn refined(&self) -> Histogram {
         let total: f64 = self.nodes[0].energy.iter().map(|&e| f64::from(e)).sum();
         let mut nodes = vec![HistogramNode::new()];
         if total > 0.0 {
-            self.refine_from(&mut nodes, 0, Some(0), total, 1, 0.0);
+            self.refine_from(&mut nodes, 0, Some(0), total, 1, (0.0, 0.0));
         }
         Histogram { nodes }
     }
 
     /// Fills node `at` of `out` from node `from` of this tree (`None`: a leaf quadrant
-    /// being split, whose energy `parent_share` is spread evenly over its quarters).
+    /// being split, whose energy and records `parent_share` are spread evenly over its
+    /// quarters).
     fn refine_from(
         &self,
         out: &mut Vec<HistogramNode>,
@@ -181,24 +189,29 @@ impl Distribution {
         from: Option<usize>,
         total: f64,
         depth: u32,
-        parent_share: f64,
+        parent_share: (f64, f64),
     ) {
         for q in 0..4 {
-            let (energy, child) = match from {
+            let (energy, records, child) = match from {
                 Some(n) => (
                     f64::from(self.nodes[n].energy[q]),
+                    f64::from(self.nodes[n].records[q]),
                     match self.nodes[n].children[q] {
                         LEAF => None,
                         c => Some(c as usize),
                     },
                 ),
-                None => (parent_share / 4.0, None),
+                None => (parent_share.0 / 4.0, parent_share.1 / 4.0, None),
             };
-            if depth < MAX_DEPTH && energy / total > SUBDIVIDE_FRACTION {
+            if depth < MAX_DEPTH && energy / total > SUBDIVIDE_FRACTION && records >= MIN_RECORDS {
                 let index = out.len();
                 out.push(HistogramNode::new());
                 out[at].children[q] = index as u32;
-                let share = if child.is_none() { energy } else { 0.0 };
+                let share = if child.is_none() {
+                    (energy, records)
+                } else {
+                    (0.0, 0.0)
+                };
                 self.refine_from(out, index, child, total, depth + 1, share);
             }
         }
@@ -228,6 +241,7 @@ fn choose(u: f32, p: f32) -> (usize, f32) {
 struct HistogramNode {
     children: [u32; 4],
     energy: [AtomicU64; 4],
+    records: [AtomicU32; 4],
 }
 
 impl HistogramNode {
@@ -235,6 +249,7 @@ impl HistogramNode {
         HistogramNode {
             children: [LEAF; 4],
             energy: Default::default(),
+            records: Default::default(),
         }
     }
 }
@@ -246,17 +261,19 @@ pub struct Histogram {
 }
 
 impl Histogram {
-    /// Adds `energy` (≥ 0) arriving from the unit direction `d` to every node on the way
-    /// to its leaf. Non-finite or negative energies add nothing.
+    /// Adds `energy` (≥ 0) arriving from the unit direction `d`, and one record, to every
+    /// node on the way to its leaf. Non-finite or negative energies count as none.
     pub fn record(&self, d: Vec3, energy: f32) {
-        if !(energy > 0.0 && energy.is_finite()) {
-            return;
-        }
-        let units = (f64::from(energy).min(MAX_RECORD) * FIXED_SCALE).round() as u64;
+        let units = if energy > 0.0 && energy.is_finite() {
+            (f64::from(energy).min(MAX_RECORD) * FIXED_SCALE).round() as u64
+        } else {
+            0
+        };
         let (mut node, mut p) = (0usize, to_square(d));
         loop {
             let q = quadrant(p);
             self.nodes[node].energy[q].fetch_add(units, Ordering::Relaxed);
+            self.nodes[node].records[q].fetch_add(1, Ordering::Relaxed);
             match self.nodes[node].children[q] {
                 LEAF => return,
                 child => {
@@ -278,6 +295,7 @@ impl Histogram {
                     energy: std::array::from_fn(|q| {
                         (n.energy[q].load(Ordering::Relaxed) as f64 / FIXED_SCALE) as f32
                     }),
+                    records: std::array::from_fn(|q| n.records[q].load(Ordering::Relaxed)),
                 })
                 .collect(),
         }
@@ -299,10 +317,10 @@ mod tests {
         let mut histogram = Distribution::uniform().refined();
         let mut distribution = Distribution::uniform();
         for _ in 0..5 {
-            for i in 0..4000u32 {
+            for i in 0..64_000u32 {
                 let u = Vec2::new(
-                    (i as f32 + 0.5) / 4000.0,
-                    ((i * 40503) % 4000) as f32 / 4000.0,
+                    (i as f32 + 0.5) / 64_000.0,
+                    ((i * 40503) % 64_000) as f32 / 64_000.0,
                 );
                 let d = to_sphere(u);
                 histogram.record(d, radiance(d));
@@ -311,7 +329,7 @@ mod tests {
             histogram = distribution.refined();
         }
         assert!(
-            distribution.nodes.len() > 20,
+            distribution.nodes.len() > 10,
             "the tree was refined: {} nodes",
             distribution.nodes.len()
         );
@@ -354,6 +372,22 @@ mod tests {
                 "sample {p}: {pdf} vs pdf {at}"
             );
         }
+    }
+
+    #[test]
+    fn a_peak_few_records_saw_is_not_resolved_finer_than_they_can() {
+        let histogram = Distribution::uniform().refined();
+        let peak = Vec3::new(0.2, 0.3, 0.93).normalize();
+        for i in 0..10 {
+            histogram.record(peak, 1000.0 + i as f32);
+        }
+        histogram.record(-peak, 1.0);
+        let refined = histogram.freeze().refined();
+        assert_eq!(
+            refined.nodes.len(),
+            1,
+            "10 records split the root's quadrants"
+        );
     }
 
     #[test]

@@ -1,53 +1,79 @@
-//! Training the guide: passes of guided paths over the whole image whose only product is
-//! what they record, each pass sampling from what the previous ones learned (Müller et al.
-//! 2017, §3.4, with a fixed schedule rather than one that grows with the render, so that
-//! every process of a split render, whatever its range, trains the same guide).
+//! Training the guide on the image's own first samples (Müller et al. 2017, §3.4, with a
+//! fixed schedule): samples 0, 1, 2–3, 4–7 and 8–15 of every pixel are the training passes.
+//! Each is traced with the guide as the passes before it left it and records into the
+//! guide, which is rebuilt at the end of the pass; later samples use the final guide.
+//!
+//! A sample's value therefore depends only on (seed, pixel, index) and the scene, as
+//! without guiding: a process that renders a range starting after sample 0 first traces
+//! the training samples before its range, keeping nothing but what they teach the guide,
+//! and so holds the same guide at every index as a process that rendered them.
 
 use rayon::prelude::*;
 
 use super::Guide;
 use crate::render::integrator::PathGuiding;
 use crate::render::sampler::Sampler;
-use crate::render::sampling::mix64;
 use crate::render::{CameraSampling, RenderSettings, Renderer};
 
-/// Samples per pixel of each training pass: 8 in all, a small share of a final render's.
-pub const TRAINING_PASSES: [u32; 4] = [1, 1, 2, 4];
+/// Samples per pixel of each training pass.
+const TRAINING_PASSES: [u32; 5] = [1, 1, 2, 4, 8];
 
-/// Mixed into the seed of training samples, so that their streams are not the image's.
-const TRAINING_STREAM: u64 = 0x6775_6964_696e_6721;
+/// The first sample index after training.
+pub const TRAINING_SAMPLES: u32 = 16;
+
+/// How a path at sample index `sample` uses `guide`: it trains it during the training
+/// passes and only samples it after.
+pub fn guiding_at(guide: Option<&Guide>, sample: u32) -> PathGuiding<'_> {
+    match guide {
+        None => PathGuiding::Off,
+        Some(g) if sample < TRAINING_SAMPLES => PathGuiding::Train(g),
+        Some(g) => PathGuiding::Sample(g),
+    }
+}
+
+impl Guide {
+    /// Called once every pixel's sample `sample` is traced: ends the training pass that
+    /// sample closes, if it closes one.
+    pub fn after_sample(&mut self, sample: u32) {
+        let mut end = 0;
+        for (pass, spp) in TRAINING_PASSES.iter().enumerate() {
+            end += spp;
+            if sample + 1 == end {
+                self.end_pass(pass as u32);
+            }
+        }
+    }
+}
 
 impl Renderer<'_> {
-    /// Trains a guide for this view: [`TRAINING_PASSES`], each over every pixel, on
-    /// random streams of their own. The result depends on the scene, the view and the
-    /// settings' seed and depth alone, not on the thread count or the sample range.
-    pub(crate) fn train_guide(&self, view: &CameraSampling, settings: &RenderSettings) -> Guide {
-        let mut guide = Guide::new(self.scene.bounds());
-        let seed = mix64(mix64(settings.seed) ^ TRAINING_STREAM);
+    /// Traces the training samples `0..end` of every pixel (`end` at most
+    /// [`TRAINING_SAMPLES`]) into `guide`, keeping no image: what a process whose range
+    /// starts at `end` needs to hold the guide the whole render holds there.
+    pub(crate) fn train_guide_before(
+        &self,
+        view: &CameraSampling,
+        settings: &RenderSettings,
+        guide: &mut Guide,
+        end: u32,
+    ) {
+        let seed = crate::render::sampling::mix64(settings.seed);
         let (width, height) = (settings.width as usize, settings.height as usize);
-        let mut first = 0u32;
-        for (pass, &spp) in TRAINING_PASSES.iter().enumerate() {
-            let indices = first..first + spp;
+        for sample in 0..end.min(TRAINING_SAMPLES) {
             (0..height).into_par_iter().for_each(|y| {
                 for x in 0..width {
-                    let pixel = (y * width + x) as u64;
-                    for index in indices.clone() {
-                        let mut sampler = Sampler::for_sample(seed, pixel, index);
-                        let ray = view.ray(x, y, &mut sampler);
-                        self.trace_path_guided(
-                            ray,
-                            &mut sampler,
-                            settings.max_depth,
-                            settings.strategy,
-                            false,
-                            PathGuiding::Train(&guide),
-                        );
-                    }
+                    let mut sampler = Sampler::for_sample(seed, (y * width + x) as u64, sample);
+                    let ray = view.ray(x, y, &mut sampler);
+                    self.trace_path_guided(
+                        ray,
+                        &mut sampler,
+                        settings.max_depth,
+                        settings.strategy,
+                        false,
+                        PathGuiding::Train(guide),
+                    );
                 }
             });
-            guide.end_pass(pass as u32);
-            first += spp;
+            guide.after_sample(sample);
         }
-        guide
     }
 }
