@@ -112,7 +112,7 @@ impl Renderer<'_> {
         )
     }
 
-    /// [`Renderer::trace_path_with_features`], drawing directions at rough vertices also
+    /// [`Renderer::trace_path_with_features`], drawing directions at diffuse vertices also
     /// from a guide when `guiding` has one ([`super::guiding`]).
     pub fn trace_path_guided(
         &self,
