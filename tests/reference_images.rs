@@ -32,6 +32,13 @@ fn caustic_under_a_glass_sphere_matches_cycles() {
     check_scene("caustic", CAUSTIC_SPP);
 }
 
+/// A room lit only through a glazed window: every lit path crosses the pane by a BSDF
+/// bounce, so its blocks are heavy-tailed like the caustics'.
+#[test]
+fn room_lit_through_a_window_matches_cycles() {
+    check_scene("window_room", CAUSTIC_SPP);
+}
+
 #[test]
 fn coloured_and_small_lights_match_cycles() {
     check_scene("coloured_lights", 512);
