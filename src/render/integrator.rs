@@ -12,6 +12,7 @@ use super::aov::Features;
 use super::guiding::{Guide, GuidedBsdf, Record};
 use super::sampler::Sampler;
 use super::sampling::power_heuristic;
+use super::shading::Shading;
 use super::surface::{Surface, surface_at};
 use crate::accel::{Ray, SceneHit};
 use crate::geometry::offset_ray_origin;
@@ -80,6 +81,196 @@ pub struct PathResult {
     pub features: Features,
 }
 
+/// What a path is asked to do: its most scattering events, its direct-light estimator and
+/// its guide.
+#[derive(Clone, Copy)]
+struct Asked<'a> {
+    max_depth: u32,
+    strategy: Strategy,
+    guiding: PathGuiding<'a>,
+}
+
+/// A scattering vertex, as the bounce from it needs it.
+struct Vertex<'a> {
+    surface: &'a Surface,
+    /// Geometric and shading normals on the side the path arrived from.
+    ng: Vec3,
+    ns: Vec3,
+    /// Towards where the path came from.
+    wo: Vec3,
+    /// True when a refraction here enters an absorbing volume (through the front face).
+    entering: bool,
+    /// The volume's absorption coefficient.
+    absorption: Vec3,
+    /// The guide's region holding the vertex (0 when unguided).
+    region: u32,
+}
+
+/// The state a path carries from vertex to vertex.
+struct Path {
+    ray: Ray,
+    /// Throughput from the camera.
+    beta: Vec3,
+    arrival: Arrival,
+    /// Absorption coefficient of the glass volume the path is inside, if any.
+    medium: Option<Vec3>,
+    /// Distance from the last scattering vertex, across surfaces alpha let the ray through.
+    travelled: f32,
+    /// Distance along the path from the camera, for the depth layer.
+    path_length: f32,
+    /// Scattering events so far.
+    depth: u32,
+    /// Surfaces passed since the last scattering event.
+    pass_throughs: u32,
+    /// Where the path last scattered (the camera at first): light densities are seen
+    /// from there.
+    vertex: Vec3,
+    /// Its shading normal, which the light tree weighs lights with (none at the camera).
+    vertex_normal: Vec3,
+    /// Features still to be found: the path has not reached a rough surface yet.
+    seeking: bool,
+    result: PathResult,
+    /// Guided vertices of a training path, completed when it ends.
+    records: Vec<Record>,
+}
+
+impl Path {
+    fn new(ray: Ray, want_features: bool) -> Path {
+        Path {
+            ray,
+            beta: Vec3::ONE,
+            arrival: Arrival::Specular,
+            medium: None,
+            travelled: 0.0,
+            path_length: 0.0,
+            depth: 0,
+            pass_throughs: 0,
+            vertex: ray.origin,
+            vertex_normal: Vec3::ZERO,
+            seeking: want_features,
+            result: PathResult::default(),
+            records: Vec::new(),
+        }
+    }
+
+    /// The last scattering vertex, its normal and the distance travelled since: where
+    /// emission the path finds is weighed from.
+    fn from(&self) -> (Vec3, Vec3, f32) {
+        (self.vertex, self.vertex_normal, self.travelled)
+    }
+
+    /// Moves along the ray to its hit at parameter `t`, through the volume it is in.
+    fn travel(&mut self, t: f32) {
+        let segment = t * self.ray.direction.length();
+        self.travelled += segment;
+        self.path_length += segment;
+        if let Some(sigma) = self.medium {
+            self.beta *= (-sigma * segment).exp();
+        }
+    }
+
+    /// Goes on past `s` in the same direction; false once too many surfaces were passed.
+    fn pass_through(&mut self, s: &Surface) -> bool {
+        self.pass_throughs += 1;
+        if self.pass_throughs > MAX_PASS_THROUGHS {
+            return false;
+        }
+        let ng = s.geometric_normal;
+        self.ray = Ray::new(
+            offset_ray_origin(s.point, s.point_error, ng, self.ray.direction),
+            self.ray.direction,
+        )
+        .at_time(s.time);
+        true
+    }
+
+    /// Albedo and normal of every surface on the way, so a path that ends at a mirror or
+    /// in glass still reports the last surface it met; a rough surface ends the search.
+    fn note_features(&mut self, shading: &Shading, s: &Surface, wo: Vec3, unlit: bool) {
+        if !self.seeking {
+            return;
+        }
+        let n = if shading.normal.dot(wo) < 0.0 {
+            -shading.normal
+        } else {
+            shading.normal
+        };
+        self.result.features = Features {
+            albedo: shading.base_colour,
+            normal: n,
+            position: s.point,
+            distance: self.path_length,
+            surface: true,
+        };
+        self.seeking = shading.bsdf.is_delta() && !unlit;
+    }
+
+    /// Samples the next direction at `vertex` and moves the path onto it; false when the
+    /// path ends (no direction, a leak through the geometric surface, Russian roulette).
+    fn extend(
+        &mut self,
+        vertex: &Vertex,
+        scatter: &GuidedBsdf,
+        sampler: &mut Sampler,
+        guiding: PathGuiding,
+    ) -> bool {
+        let s = vertex.surface;
+        let Some(sample) = scatter.sample(vertex.ns, vertex.wo, sampler) else {
+            return false;
+        };
+        let side = sample.wi.dot(vertex.ng);
+        if (sample.is_transmission && side >= 0.0) || (!sample.is_transmission && side <= 0.0) {
+            return false;
+        }
+        self.beta *= sample.weight;
+        if matches!(guiding, PathGuiding::Train(_)) && scatter.guide.is_some() && !sample.is_delta {
+            self.records.push(Guide::record(
+                vertex.region,
+                sample.wi,
+                sample.pdf,
+                self.beta,
+                self.result.radiance,
+            ));
+        }
+        if sample.is_transmission {
+            // Entering through the front face puts the path inside the volume.
+            self.medium = vertex.entering.then_some(vertex.absorption);
+        }
+        self.arrival = if sample.is_delta {
+            Arrival::Specular
+        } else {
+            Arrival::Scattered { pdf: sample.pdf }
+        };
+        self.ray = Ray::new(
+            offset_ray_origin(s.point, s.point_error, vertex.ng, sample.wi),
+            sample.wi,
+        )
+        .at_time(s.time);
+        self.vertex = s.point;
+        self.vertex_normal = vertex.ns;
+        self.travelled = 0.0;
+        self.depth += 1;
+        self.pass_throughs = 0;
+
+        // Possibly terminate the path with Russian roulette. Paths survive with the
+        // square root of the throughput, as in Cycles
+        // (`path_state_continuation_probability`): later than with the throughput
+        // itself, which lowered the error at equal time by 10–25 % on the reference
+        // scenes (tools/blender/efficiency.py).
+        if self.depth >= ROULETTE_DEPTH {
+            let rr = self.beta.max_element().sqrt();
+            if rr < 1.0 {
+                let q = (1.0 - rr).clamp(0.05, 0.95);
+                if sampler.uniform() < q {
+                    return false;
+                }
+                self.beta /= 1.0 - q;
+            }
+        }
+        self.beta.is_finite() && self.beta != Vec3::ZERO
+    }
+}
+
 impl Renderer<'_> {
     /// Estimates the radiance arriving along `ray` (pointing into the scene).
     pub fn trace_path(
@@ -116,238 +307,175 @@ impl Renderer<'_> {
     /// from a guide when `guiding` has one ([`super::guiding`]).
     pub fn trace_path_guided(
         &self,
-        mut ray: Ray,
+        ray: Ray,
         sampler: &mut Sampler,
         max_depth: u32,
         strategy: Strategy,
         want_features: bool,
         guiding: PathGuiding,
     ) -> PathResult {
-        let mut result = PathResult::default();
-        // Guided vertices of a training path, completed when it ends.
-        let mut records: Vec<Record> = Vec::new();
-        // Features still to be found: the path has not reached a rough surface yet.
-        let mut seeking = want_features;
-        // Distance along the path from the camera, for the depth layer.
-        let mut path_length = 0.0f32;
-        let mut beta = Vec3::ONE;
-        let mut arrival = Arrival::Specular;
-        // Absorption coefficient of the glass volume the path is inside, if any.
-        let mut medium: Option<Vec3> = None;
-        // Distance from the last scattering vertex, across surfaces alpha let the ray through.
-        let mut travelled = 0.0f32;
-        let mut depth = 0;
-        let mut pass_throughs = 0;
-        // Where the path last scattered (the camera at first): light densities are seen
-        // from there.
-        let mut vertex = ray.origin;
-        // Its shading normal, which the light tree weighs lights with (none at the camera).
-        let mut vertex_normal = Vec3::ZERO;
+        let asked = Asked {
+            max_depth,
+            strategy,
+            guiding,
+        };
+        let mut path = Path::new(ray, want_features);
         loop {
-            result.rays += 1;
-            let hit = self.accel.intersect(&ray);
-            if self.lights.has_spheres() {
-                // Sphere lamps the segment passes before its hit, which it goes on through.
-                let length = ray.direction.length();
-                let t_max = hit.map_or(f32::INFINITY, |h| h.t * length);
-                let (origin, d) = (ray.origin, ray.direction / length);
-                self.lights.spheres_along(
-                    vertex,
-                    vertex_normal,
-                    origin,
-                    d,
-                    t_max,
-                    depth == 0,
-                    |l, light_pdf, t| {
-                        let weight = emission_weight(arrival, strategy, light_pdf);
-                        let through = medium.map_or(Vec3::ONE, |sigma| (-sigma * t).exp());
-                        result.radiance += weight * beta * through * l;
-                    },
-                );
-            }
+            path.result.rays += 1;
+            let hit = self.accel.intersect(&path.ray);
+            self.add_sphere_lamps(&mut path, hit.as_ref(), strategy);
             let Some(hit) = hit else {
-                // The path leaves the scene: the environment, weighed like any emitter,
-                // unless it is hidden from camera rays.
-                let (environment, light_pdf) =
-                    self.lights
-                        .environment(vertex, vertex_normal, ray.direction);
-                if depth == 0 && !self.environment_visible {
-                    break;
-                }
-                if seeking {
-                    result.features = Features {
-                        albedo: environment.min(Vec3::ONE),
-                        ..Features::default()
-                    };
-                }
-                if environment != Vec3::ZERO {
-                    let weight = emission_weight(arrival, strategy, light_pdf);
-                    result.radiance += weight * beta * environment;
-                }
+                self.leave_scene(&mut path, strategy);
                 break;
             };
-            let segment = hit.t * ray.direction.length();
-            travelled += segment;
-            path_length += segment;
-            if let Some(sigma) = medium {
-                beta *= (-sigma * segment).exp();
-            }
+            path.travel(hit.t);
             let s = surface_at(self.scene, &self.frames, &hit);
             let material = &self.scene.materials[s.material];
-            let hidden = depth == 0 && !material.camera_visible;
-            if material.lamp && !hidden && s.geometric_normal.dot(ray.direction) < 0.0 {
+            let hidden = path.depth == 0 && !material.camera_visible;
+            if material.lamp && !hidden && s.geometric_normal.dot(path.ray.direction) < 0.0 {
                 // A lamp's shape: its light, weighed like any emitter's, and the ray goes on.
-                let cos_o = -s.geometric_normal.dot(ray.direction.normalize());
-                let from = (vertex, vertex_normal, travelled);
-                let weight = self.emission_weight_at(&hit, from, cos_o, arrival, strategy);
-                result.radiance += weight * beta * self.shade(&s, true).emission;
+                let cos_o = -s.geometric_normal.dot(path.ray.direction.normalize());
+                let weight =
+                    self.emission_weight_at(&hit, path.from(), cos_o, path.arrival, strategy);
+                path.result.radiance += weight * path.beta * self.shade(&s, true).emission;
             }
             if hidden || !self.is_present(&s, sampler) {
                 // A cutout, a blended surface the ray passes, a lamp or a surface the
                 // camera does not see: go on in the same direction.
-                pass_throughs += 1;
-                if pass_throughs > MAX_PASS_THROUGHS {
+                if !path.pass_through(&s) {
                     break;
                 }
-                let ng = s.geometric_normal;
-                ray = Ray::new(
-                    offset_ray_origin(s.point, s.point_error, ng, ray.direction),
-                    ray.direction,
-                )
-                .at_time(s.time);
                 continue;
             }
-            result.hit |= depth == 0;
-            let wo = -ray.direction.normalize();
-            let cos_o = s.geometric_normal.dot(wo);
-            let front = cos_o > 0.0;
-            let shading = self.shade(&s, front);
-            if seeking {
-                // Albedo and normal of every surface on the way, so a path that ends at a
-                // mirror or in glass still reports the last surface it met; a rough
-                // surface ends the search.
-                let n = if shading.normal.dot(wo) < 0.0 {
-                    -shading.normal
-                } else {
-                    shading.normal
-                };
-                result.features = Features {
-                    albedo: shading.base_colour,
-                    normal: n,
-                    position: s.point,
-                    distance: path_length,
-                    surface: true,
-                };
-                seeking = shading.bsdf.is_delta() && !material.unlit;
-            }
-            if material.unlit {
-                if matches!(arrival, Arrival::Specular) {
-                    result.radiance += beta * shading.base_colour;
-                }
-                break;
-            }
-
-            // Emission reached by the previous bounce.
-            if material.is_emissive() && (front || material.double_sided) {
-                let from = (vertex, vertex_normal, travelled);
-                let weight = self.emission_weight_at(&hit, from, cos_o, arrival, strategy);
-                result.radiance += weight * beta * shading.emission;
-            }
-            // A one-sided surface's back is black, but for glass it is the inside of the
-            // volume. Whether this point is glass is read from the material as textured here
-            // (a glTF metallic texture can make a metal factor 0), not from its factors.
-            let two_sided = material.double_sided || shading.bsdf.transmits();
-            if depth == max_depth || (!front && !two_sided) {
-                break;
-            }
-
-            let ng = if front {
-                s.geometric_normal
-            } else {
-                -s.geometric_normal
-            };
-            let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo);
-            let (guide, region) = match guiding.guide() {
-                Some(g) if bsdf.is_guidable() => {
-                    let (distribution, region) = g.at(s.point);
-                    (Some(distribution), region)
-                }
-                _ => (None, 0),
-            };
-            let scatter = GuidedBsdf { bsdf: &bsdf, guide };
-
-            // Sample a light for the next-event estimate. Punctual lights can only be found
-            // this way, so even the BSDF-only estimator samples them.
-            if !bsdf.is_delta()
-                && (strategy != Strategy::BsdfOnly || self.lights.punctual_len() > 0)
-            {
-                result.rays += 1;
-                result.radiance +=
-                    beta * self.direct_light(&scatter, &s, ng, ns, wo, sampler, strategy);
-            }
-
-            // Sample the BSDF to extend the path.
-            let Some(sample) = scatter.sample(ns, wo, sampler) else {
-                break;
-            };
-            let side = sample.wi.dot(ng);
-            if (sample.is_transmission && side >= 0.0) || (!sample.is_transmission && side <= 0.0) {
-                break;
-            }
-            beta *= sample.weight;
-            if matches!(guiding, PathGuiding::Train(_)) && guide.is_some() && !sample.is_delta {
-                records.push(Guide::record(
-                    region,
-                    sample.wi,
-                    sample.pdf,
-                    beta,
-                    result.radiance,
-                ));
-            }
-            if sample.is_transmission {
-                // Entering through the front face puts the path inside the volume.
-                medium =
-                    (front && material.absorption != Vec3::ZERO).then_some(material.absorption);
-            }
-            arrival = if sample.is_delta {
-                Arrival::Specular
-            } else {
-                Arrival::Scattered { pdf: sample.pdf }
-            };
-            ray = Ray::new(
-                offset_ray_origin(s.point, s.point_error, ng, sample.wi),
-                sample.wi,
-            )
-            .at_time(s.time);
-            vertex = s.point;
-            vertex_normal = ns;
-            travelled = 0.0;
-            depth += 1;
-            pass_throughs = 0;
-
-            // Possibly terminate the path with Russian roulette. Paths survive with the
-            // square root of the throughput, as in Cycles
-            // (`path_state_continuation_probability`): later than with the throughput
-            // itself, which lowered the error at equal time by 10–25 % on the reference
-            // scenes (tools/blender/efficiency.py).
-            if depth >= ROULETTE_DEPTH {
-                let rr = beta.max_element().sqrt();
-                if rr < 1.0 {
-                    let q = (1.0 - rr).clamp(0.05, 0.95);
-                    if sampler.uniform() < q {
-                        break;
-                    }
-                    beta /= 1.0 - q;
-                }
-            }
-            if !beta.is_finite() || beta == Vec3::ZERO {
+            if !self.scatter_at(&mut path, &hit, &s, sampler, asked) {
                 break;
             }
         }
         if let PathGuiding::Train(guide) = guiding {
-            guide.add_path(&records, result.radiance);
+            guide.add_path(&path.records, path.result.radiance);
         }
-        result
+        path.result
+    }
+
+    /// Sphere lamps the path's segment passes before its hit (`None`: the segment leaves
+    /// the scene), which it goes on through.
+    fn add_sphere_lamps(&self, path: &mut Path, hit: Option<&SceneHit>, strategy: Strategy) {
+        if !self.lights.has_spheres() {
+            return;
+        }
+        let length = path.ray.direction.length();
+        let t_max = hit.map_or(f32::INFINITY, |h| h.t * length);
+        let (origin, d) = (path.ray.origin, path.ray.direction / length);
+        let (arrival, medium, beta) = (path.arrival, path.medium, path.beta);
+        let radiance = &mut path.result.radiance;
+        self.lights.spheres_along(
+            path.vertex,
+            path.vertex_normal,
+            origin,
+            d,
+            t_max,
+            path.depth == 0,
+            |l, light_pdf, t| {
+                let weight = emission_weight(arrival, strategy, light_pdf);
+                let through = medium.map_or(Vec3::ONE, |sigma| (-sigma * t).exp());
+                *radiance += weight * beta * through * l;
+            },
+        );
+    }
+
+    /// The path leaves the scene: the environment, weighed like any emitter, unless it is
+    /// hidden from camera rays.
+    fn leave_scene(&self, path: &mut Path, strategy: Strategy) {
+        let (environment, light_pdf) =
+            self.lights
+                .environment(path.vertex, path.vertex_normal, path.ray.direction);
+        if path.depth == 0 && !self.environment_visible {
+            return;
+        }
+        if path.seeking {
+            path.result.features = Features {
+                albedo: environment.min(Vec3::ONE),
+                ..Features::default()
+            };
+        }
+        if environment != Vec3::ZERO {
+            let weight = emission_weight(path.arrival, strategy, light_pdf);
+            path.result.radiance += weight * path.beta * environment;
+        }
+    }
+
+    /// The path meets the surface `s` of `hit`: its emission, direct light and the next
+    /// direction. False when the path ends here.
+    fn scatter_at(
+        &self,
+        path: &mut Path,
+        hit: &SceneHit,
+        s: &Surface,
+        sampler: &mut Sampler,
+        asked: Asked,
+    ) -> bool {
+        let material = &self.scene.materials[s.material];
+        path.result.hit |= path.depth == 0;
+        let wo = -path.ray.direction.normalize();
+        let cos_o = s.geometric_normal.dot(wo);
+        let front = cos_o > 0.0;
+        let shading = self.shade(s, front);
+        path.note_features(&shading, s, wo, material.unlit);
+        if material.unlit {
+            if matches!(path.arrival, Arrival::Specular) {
+                path.result.radiance += path.beta * shading.base_colour;
+            }
+            return false;
+        }
+
+        // Emission reached by the previous bounce.
+        if material.is_emissive() && (front || material.double_sided) {
+            let weight =
+                self.emission_weight_at(hit, path.from(), cos_o, path.arrival, asked.strategy);
+            path.result.radiance += weight * path.beta * shading.emission;
+        }
+        // A one-sided surface's back is black, but for glass it is the inside of the
+        // volume. Whether this point is glass is read from the material as textured here
+        // (a glTF metallic texture can make a metal factor 0), not from its factors.
+        let two_sided = material.double_sided || shading.bsdf.transmits();
+        if path.depth == asked.max_depth || (!front && !two_sided) {
+            return false;
+        }
+
+        let ng = if front {
+            s.geometric_normal
+        } else {
+            -s.geometric_normal
+        };
+        let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo);
+        let (guide, region) = match asked.guiding.guide() {
+            Some(g) if bsdf.is_guidable() => {
+                let (distribution, region) = g.at(s.point);
+                (Some(distribution), region)
+            }
+            _ => (None, 0),
+        };
+        let scatter = GuidedBsdf { bsdf: &bsdf, guide };
+
+        // Sample a light for the next-event estimate. Punctual lights can only be found
+        // this way, so even the BSDF-only estimator samples them.
+        if !bsdf.is_delta()
+            && (asked.strategy != Strategy::BsdfOnly || self.lights.punctual_len() > 0)
+        {
+            path.result.rays += 1;
+            path.result.radiance +=
+                path.beta * self.direct_light(&scatter, s, ng, ns, wo, sampler, asked.strategy);
+        }
+        let vertex = Vertex {
+            surface: s,
+            ng,
+            ns,
+            wo,
+            entering: front && material.absorption != Vec3::ZERO,
+            absorption: material.absorption,
+            region,
+        };
+        path.extend(&vertex, &scatter, sampler, asked.guiding)
     }
 
     /// One light-sampling estimate of reflected direct light, MIS-weighted when asked.
