@@ -106,17 +106,7 @@ fn merged_parts_equal_one_render_for_one_two_and_four_parts() {
         for pair in bounds.windows(2).rev() {
             let range = pair[0]..pair[1];
             let part = render(&renderer, &camera, range.clone(), 3);
-            let path = dir
-                .path()
-                .join(format!("part-{}-{}.exr", range.start, range.end));
-            write_image_with_record(
-                &path,
-                &part,
-                Some(&record(range, 3)),
-                ViewTransform::Standard,
-            )
-            .unwrap();
-            paths.push(path);
+            paths.push(write_rendered_part(dir.path(), &part, range, 3));
         }
         let (merged, merged_record) = merge_files(&paths, Some(0..SPP)).unwrap();
         assert_eq!(merged_record.samples, 0..SPP);
@@ -153,15 +143,7 @@ fn guided_parts_merge_to_the_guided_whole() {
     let mut paths = Vec::new();
     for range in [0..5, 5..SPP] {
         let part = render_guided(&renderer, &camera, range.clone(), 3, Guiding::On);
-        let path = dir.path().join(format!("part-{}.exr", range.start));
-        write_image_with_record(
-            &path,
-            &part,
-            Some(&record(range, 3)),
-            ViewTransform::Standard,
-        )
-        .unwrap();
-        paths.push(path);
+        paths.push(write_rendered_part(dir.path(), &part, range, 3));
     }
     let (merged, _) = merge_files(&paths, Some(0..SPP)).unwrap();
     let difference = relative_difference(&merged, &whole);
@@ -172,6 +154,20 @@ fn guided_parts_merge_to_the_guided_whole() {
     // Guiding changed the samples: the comparison is of guided renders.
     let unguided = render(&renderer, &camera, 0..SPP, 3);
     assert!(relative_difference(&unguided, &whole) > 1000.0 * MERGE_TOLERANCE);
+}
+
+/// Writes the rendered samples `range` (seed `seed`) as a part in `dir` and returns its
+/// path.
+fn write_rendered_part(dir: &Path, part: &Image, range: Range<u32>, seed: u64) -> PathBuf {
+    let path = dir.join(format!("part-{}-{}.exr", range.start, range.end));
+    write_image_with_record(
+        &path,
+        part,
+        Some(&record(range, seed)),
+        ViewTransform::Standard,
+    )
+    .unwrap();
+    path
 }
 
 /// Writes a part with `record` and returns its path.
