@@ -30,7 +30,7 @@ mod oracles;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use gridtrace::accel::{Grid, Ray, TraversalCounts, TraversalStats};
+use gridtrace::accel::{Grid, PACKET_RAYS, Ray, TraversalCounts, TraversalStats};
 use gridtrace::geometry::Aabb;
 use gridtrace::load::ply;
 use oracles::embree::Embree;
@@ -66,15 +66,27 @@ fn summary(mut values: Vec<f64>) -> (f64, f64, f64) {
 
 type Query<'a> = Box<dyn Fn(&Ray) -> bool + 'a>;
 
+/// A query over a run of rays, answering how many hit: for packet queries.
+type ChunkQuery<'a> = Box<dyn Fn(&[Ray]) -> usize + 'a>;
+
 /// One run over a ray set: Mrays/s of each query, interleaved chunk by chunk.
 fn run_once(rays: &[Ray], queries: &[Query], run: usize) -> Vec<f64> {
+    let chunked: Vec<ChunkQuery> = queries
+        .iter()
+        .map(|q| Box::new(move |c: &[Ray]| c.iter().filter(|r| q(r)).count()) as ChunkQuery)
+        .collect();
+    run_chunks(rays, &chunked, run)
+}
+
+/// [`run_once`] for queries that take a chunk of rays at a time.
+fn run_chunks(rays: &[Ray], queries: &[ChunkQuery], run: usize) -> Vec<f64> {
     let mut total = vec![Duration::ZERO; queries.len()];
     for (c, chunk) in rays.chunks(CHUNK).enumerate() {
         for k in 0..queries.len() {
             let q = (k + c + run) % queries.len();
             let best = (0..REPEATS)
                 .map(|_| {
-                    let (hits, t) = timed(|| chunk.iter().filter(|r| queries[q](r)).count());
+                    let (hits, t) = timed(|| queries[q](chunk));
                     std::hint::black_box(hits);
                     t
                 })
@@ -87,6 +99,80 @@ fn run_once(rays: &[Ray], queries: &[Query], run: usize) -> Vec<f64> {
         .iter()
         .map(|t| rays.len() as f64 / t.as_secs_f64() / 1e6)
         .collect()
+}
+
+/// Camera rays (in tiles of 8 × 8, [`camera_rays`]) traced as packets: the grid's
+/// [`Grid::intersect_packet`] against Embree's `rtcIntersect1` and its widest native packet
+/// query, with the grid's single rays beside them. Table rows as the main table's (grid
+/// packets over each Embree query) and a note.
+fn packet_rows(
+    model: &str,
+    n: usize,
+    grid: &Grid,
+    embree: &Embree,
+    rays: &[Ray],
+    runs: usize,
+) -> (Vec<String>, String) {
+    let width = embree.native_packet();
+    let grid_packets = |c: &[Ray]| {
+        let mut hits = [None; PACKET_RAYS];
+        c.chunks(PACKET_RAYS)
+            .map(|p| {
+                grid.intersect_packet(p, &mut hits[..p.len()]);
+                hits[..p.len()].iter().filter(|h| h.is_some()).count()
+            })
+            .sum()
+    };
+    let embree_packets = |c: &[Ray]| {
+        let mut hits = [None; 16];
+        c.chunks(width)
+            .map(|p| {
+                let hits = &mut hits[..p.len()];
+                match width {
+                    16 => embree.intersect16(p, hits),
+                    8 => embree.intersect8(p, hits),
+                    _ => hits
+                        .iter_mut()
+                        .zip(p)
+                        .for_each(|(h, r)| *h = embree.intersect(r)),
+                }
+                hits.iter().filter(|h| h.is_some()).count()
+            })
+            .sum()
+    };
+    let queries: Vec<ChunkQuery> = vec![
+        Box::new(grid_packets),
+        Box::new(|c: &[Ray]| c.iter().filter(|r| embree.intersect(r).is_some()).count()),
+        Box::new(embree_packets),
+        Box::new(|c: &[Ray]| c.iter().filter(|r| grid.intersect(r).is_some()).count()),
+    ];
+    let rates: Vec<Vec<f64>> = (0..runs)
+        .map(|run| run_chunks(rays, &queries, run))
+        .collect();
+    let median = |q: usize| summary(rates.iter().map(|r| r[q]).collect()).0;
+    let row = |set: &str, e: usize| {
+        let (ratio, lo, hi) = summary(rates.iter().map(|r| r[0] / r[e]).collect());
+        format!(
+            "| {model} | {n} | {set} | {:.3} | {:.3} | – | {ratio:.2} ({lo:.2}–{hi:.2}) | – |",
+            median(0),
+            median(e)
+        )
+    };
+    let (single, ..) = summary(rates.iter().map(|r| r[0] / r[3]).collect());
+    let note = format!(
+        "{model}, camera rays in packets of {PACKET_RAYS} (8 × 8 tiles), Mrays/s (median of {runs}): grid packets {:.3}, grid single rays {:.3} (packets {single:.2}× as fast), Embree rtcIntersect1 {:.3}, Embree packets of {width} {:.3}",
+        median(0),
+        median(3),
+        median(1),
+        median(2)
+    );
+    (
+        vec![
+            row("camera-packets", 1),
+            row(&format!("camera-packets-vs-{width}"), 2),
+        ],
+        note,
+    )
 }
 
 /// The medians over `runs` runs of the two figures `run_pair(run)` gives.
@@ -549,6 +635,9 @@ fn main() {
                 ));
             }
         }
+        let (rows, note) = packet_rows(model, n, &grid, &embree, &sets[1].1, runs);
+        rows.iter().for_each(|row| println!("{row}"));
+        notes.push(note);
         // Scaling of the grid over all threads, best of 5, each timing the ray set traced
         // as many times over as make it last about 0.2 s on one thread (on the small
         // meshes one pass takes a few milliseconds, too short for thread start-up and the

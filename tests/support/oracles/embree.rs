@@ -185,6 +185,92 @@ impl Embree {
     }
 }
 
+/// An `RTCRayHitN` with room behind it for the 4.4 library's `instPrimID` lanes (see
+/// [`PaddedRayHit`]).
+#[repr(C, align(64))]
+struct PaddedRayHitN<T> {
+    rayhit: T,
+    _room: [u32; 32],
+}
+
+/// Embree's packet query of `$lanes` rays (`rtcIntersect8`, `rtcIntersect16`): `$name`
+/// writes the closest hit (t, triangle index) of each of up to `$lanes` rays into `hits`.
+macro_rules! packet_query {
+    ($name:ident, $rayhit:ident, $ray:ident, $hit:ident, $call:ident, $lanes:literal) => {
+        impl Embree {
+            /// Closest hits of up to this many rays at once (Embree's packet query).
+            pub fn $name(&self, rays: &[Ray], hits: &mut [Option<(f32, u32)>]) {
+                assert!(rays.len() <= $lanes && hits.len() == rays.len());
+                let lane =
+                    |f: &dyn Fn(&Ray) -> f32| std::array::from_fn(|i| rays.get(i).map_or(0.0, f));
+                let mut padded = PaddedRayHitN {
+                    rayhit: $rayhit {
+                        ray: $ray {
+                            org_x: lane(&|r| r.origin.x),
+                            org_y: lane(&|r| r.origin.y),
+                            org_z: lane(&|r| r.origin.z),
+                            tnear: lane(&|r| r.t_min),
+                            dir_x: lane(&|r| r.direction.x),
+                            dir_y: lane(&|r| r.direction.y),
+                            dir_z: lane(&|r| r.direction.z),
+                            time: [0.0; $lanes],
+                            tfar: lane(&|r| r.t_max),
+                            mask: [u32::MAX; $lanes],
+                            id: [0; $lanes],
+                            flags: [0; $lanes],
+                        },
+                        hit: $hit {
+                            Ng_x: [0.0; $lanes],
+                            Ng_y: [0.0; $lanes],
+                            Ng_z: [0.0; $lanes],
+                            u: [0.0; $lanes],
+                            v: [0.0; $lanes],
+                            primID: [u32::MAX; $lanes],
+                            geomID: [u32::MAX; $lanes],
+                            instID: [[u32::MAX; $lanes]],
+                        },
+                    },
+                    _room: [u32::MAX; 32],
+                };
+                let valid: [i32; $lanes] = std::array::from_fn(|i| -i32::from(i < rays.len()));
+                // SAFETY: the scene is committed; `valid` has a lane per ray slot and
+                // `padded` is aligned as Embree requires and has room behind the struct.
+                unsafe { $call(valid.as_ptr(), self.scene, &mut padded.rayhit, null_mut()) };
+                let rayhit = &padded.rayhit;
+                for (i, hit) in hits.iter_mut().enumerate() {
+                    *hit = (rayhit.hit.geomID[i] != u32::MAX)
+                        .then_some((rayhit.ray.tfar[i], rayhit.hit.primID[i]));
+                }
+            }
+        }
+    };
+}
+
+packet_query!(intersect8, RTCRayHit8, RTCRay8, RTCHit8, rtcIntersect8, 8);
+packet_query!(
+    intersect16,
+    RTCRayHit16,
+    RTCRay16,
+    RTCHit16,
+    rtcIntersect16,
+    16
+);
+
+impl Embree {
+    /// The widest packet Embree traces natively on this processor: 16, 8 or 1.
+    pub fn native_packet(&self) -> usize {
+        // SAFETY: a property query of the live device.
+        let supported = |p| unsafe { rtcGetDeviceProperty(self.device, p) } != 0;
+        if supported(RTCDeviceProperty::NATIVE_RAY16_SUPPORTED) {
+            16
+        } else if supported(RTCDeviceProperty::NATIVE_RAY8_SUPPORTED) {
+            8
+        } else {
+            1
+        }
+    }
+}
+
 impl Drop for Embree {
     fn drop(&mut self) {
         // SAFETY: both handles were created in `build` and are released once.

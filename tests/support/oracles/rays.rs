@@ -142,21 +142,31 @@ fn light_segment(
     })
 }
 
-/// A pinhole camera's rays: from one point framing the box, through a square image. (For
-/// the benchmark and `tools/dev/grid-ab`; the cross-check does not use them.)
+/// A pinhole camera's rays: from one point framing the box, through a square image whose
+/// side is a multiple of 8, tile by tile (8 × 8 pixels, the tiles row by row), as a
+/// renderer traces them and as packets take them ([`gridtrace::accel::PACKET_RAYS`]): every
+/// 64 rays from the first are one tile. The last rows are cut where `count` ends. (For the benchmark, the packet test and
+/// `tools/dev/grid-ab`; the cross-check does not use them.)
 #[allow(dead_code)]
 pub fn camera_rays(bounds: &Aabb, count: usize) -> Vec<Ray> {
+    const TILE: usize = 8;
     let center = bounds.center();
     let radius = 0.5 * bounds.extent().length();
     let eye = center + Vec3::new(0.6, 0.4, 1.0).normalize() * 2.6 * radius;
     let forward = (center - eye).normalize();
     let right = forward.cross(Vec3::Y).normalize();
     let up = right.cross(forward);
-    let side = (count as f32).sqrt().ceil() as usize;
-    (0..count)
-        .map(|i| {
-            let x = ((i % side) as f32 + 0.5) / side as f32 * 2.0 - 1.0;
-            let y = ((i / side) as f32 + 0.5) / side as f32 * 2.0 - 1.0;
+    let tiles = ((count as f32).sqrt() / TILE as f32).ceil() as usize;
+    let side = tiles * TILE;
+    (0..tiles * tiles)
+        .flat_map(|tile| {
+            let (tx, ty) = (tile % tiles * TILE, tile / tiles * TILE);
+            (0..TILE * TILE).map(move |i| (tx + i % TILE, ty + i / TILE))
+        })
+        .take(count)
+        .map(|(i, j)| {
+            let x = (i as f32 + 0.5) / side as f32 * 2.0 - 1.0;
+            let y = (j as f32 + 0.5) / side as f32 * 2.0 - 1.0;
             let direction = forward + 0.42 * (x * right + y * up);
             Ray::new(eye, direction.normalize())
         })

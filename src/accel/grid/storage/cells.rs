@@ -333,6 +333,22 @@ impl CellIndex {
         Lookup::Blocks(self.offsets[k] as usize..self.offsets[k + 1] as usize, k)
     }
 
+    /// The blocks of cell `c` of record `record`'s macrocell, or `None` when it is empty:
+    /// [`CellIndex::lookup_in`] without reading reaches (for a packet, which steps through
+    /// every cell of its rectangle and leaps over none).
+    #[inline(always)]
+    pub fn blocks_in(&self, record: usize, c: IVec3) -> Option<Range<usize>> {
+        let l = local_index(c & IVec3::splat((1 << MACRO_SHIFT) - 1));
+        let record = &self.records[record];
+        let bits = record.bits[l >> 6];
+        let bit = 1u64 << (l & 63);
+        if bits & bit == 0 {
+            return None;
+        }
+        let k = (record.ranks[l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
+        Some(self.offsets[k] as usize..self.offsets[k + 1] as usize)
+    }
+
     /// The cell `l` (x + 8y + 64z within its macrocell) of macrocell `mi` (x fastest) of a
     /// grid of `macro_resolution` macrocells.
     pub fn cell_at(macro_resolution: UVec3, mi: usize, l: usize) -> IVec3 {

@@ -10,6 +10,7 @@
 use glam::UVec3;
 
 pub(in crate::accel::grid) mod occupied;
+pub(crate) mod packet;
 pub(crate) mod prefetch;
 pub(in crate::accel::grid) mod stats;
 
