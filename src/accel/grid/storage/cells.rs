@@ -288,6 +288,12 @@ impl CellIndex {
         }
     }
 
+    /// True when cell `c`'s macrocell is occupied (its word alone is read).
+    #[inline(always)]
+    pub fn macrocell_occupied(&self, c: IVec3) -> bool {
+        record_in(self.macro_words[self.macro_index(c >> MACRO_SHIFT)]).is_some()
+    }
+
     /// Starts loading what a ray moving into `octant` reads of record `record` (its
     /// occupancy, ranks and that octant's reaches) and the first two cache lines of its
     /// cells' offsets at once: the walk has just entered its macrocell and will read
@@ -331,22 +337,6 @@ impl CellIndex {
         }
         let k = (record.ranks[l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
         Lookup::Blocks(self.offsets[k] as usize..self.offsets[k + 1] as usize, k)
-    }
-
-    /// The blocks of cell `c` of record `record`'s macrocell, or `None` when it is empty:
-    /// [`CellIndex::lookup_in`] without reading reaches (for a packet, which steps through
-    /// every cell of its rectangle and leaps over none).
-    #[inline(always)]
-    pub fn blocks_in(&self, record: usize, c: IVec3) -> Option<Range<usize>> {
-        let l = local_index(c & IVec3::splat((1 << MACRO_SHIFT) - 1));
-        let record = &self.records[record];
-        let bits = record.bits[l >> 6];
-        let bit = 1u64 << (l & 63);
-        if bits & bit == 0 {
-            return None;
-        }
-        let k = (record.ranks[l >> 6] + (bits & (bit - 1)).count_ones()) as usize;
-        Some(self.offsets[k] as usize..self.offsets[k + 1] as usize)
     }
 
     /// The cell `l` (x + 8y + 64z within its macrocell) of macrocell `mi` (x fastest) of a
