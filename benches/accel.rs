@@ -17,7 +17,9 @@
 //! share of the query spent approaching the surface ([`first_cell_starts`]), the ratio to
 //! Embree over the rays that hit the mesh and over those that miss it (the shadow segments
 //! that are blocked and those that pass), each part timed alone, and the grid's speed-up on
-//! all threads (bounce rays, each timing about 0.2 s long).
+//! all threads (bounce rays, each timing about 0.2 s long). The camera rays, which come in
+//! tiles of 8 × 8, are also timed against Embree's widest native packet query
+//! (`rtcIntersect16` here): row `camera-vs-16`, the grid's single rays over Embree's packets.
 //!
 //! Run with `cargo bench --bench accel` after `tools/dev/setup.sh`. Environment:
 //! `ACCEL_BENCH_MODELS` (comma-separated files of data/dragon, default the smallest, a
@@ -30,7 +32,7 @@ mod oracles;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use gridtrace::accel::{Grid, PACKET_RAYS, Ray, TraversalCounts, TraversalStats};
+use gridtrace::accel::{Grid, Ray, TraversalCounts, TraversalStats};
 use gridtrace::geometry::Aabb;
 use gridtrace::load::ply;
 use oracles::embree::Embree;
@@ -101,28 +103,19 @@ fn run_chunks(rays: &[Ray], queries: &[ChunkQuery], run: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Camera rays (in tiles of 8 × 8, [`camera_rays`]) traced as packets: the grid's
-/// [`Grid::intersect_packet`] against Embree's `rtcIntersect1` and its widest native packet
-/// query, with the grid's single rays beside them. Table rows as the main table's (grid
-/// packets over each Embree query) and a note.
-fn packet_rows(
+/// Camera rays (in tiles of 8 × 8, [`camera_rays`]): the grid's single rays against
+/// Embree's widest native packet query (`rtcIntersect16` or `8`) besides its
+/// `rtcIntersect1`, each packet a run of consecutive rays of one tile. A table row as the
+/// main table's (the grid over Embree's packets) and a note.
+fn embree_packet_rows(
     model: &str,
     n: usize,
     grid: &Grid,
     embree: &Embree,
     rays: &[Ray],
     runs: usize,
-) -> (Vec<String>, String) {
+) -> (String, String) {
     let width = embree.native_packet();
-    let grid_packets = |c: &[Ray]| {
-        let mut hits = [None; PACKET_RAYS];
-        c.chunks(PACKET_RAYS)
-            .map(|p| {
-                grid.intersect_packet(p, &mut hits[..p.len()]);
-                hits[..p.len()].iter().filter(|h| h.is_some()).count()
-            })
-            .sum()
-    };
     let embree_packets = |c: &[Ray]| {
         let mut hits = [None; 16];
         c.chunks(width)
@@ -141,38 +134,27 @@ fn packet_rows(
             .sum()
     };
     let queries: Vec<ChunkQuery> = vec![
-        Box::new(grid_packets),
+        Box::new(|c: &[Ray]| c.iter().filter(|r| grid.intersect(r).is_some()).count()),
         Box::new(|c: &[Ray]| c.iter().filter(|r| embree.intersect(r).is_some()).count()),
         Box::new(embree_packets),
-        Box::new(|c: &[Ray]| c.iter().filter(|r| grid.intersect(r).is_some()).count()),
     ];
     let rates: Vec<Vec<f64>> = (0..runs)
         .map(|run| run_chunks(rays, &queries, run))
         .collect();
     let median = |q: usize| summary(rates.iter().map(|r| r[q]).collect()).0;
-    let row = |set: &str, e: usize| {
-        let (ratio, lo, hi) = summary(rates.iter().map(|r| r[0] / r[e]).collect());
-        format!(
-            "| {model} | {n} | {set} | {:.3} | {:.3} | – | {ratio:.2} ({lo:.2}–{hi:.2}) | – |",
-            median(0),
-            median(e)
-        )
-    };
-    let (single, ..) = summary(rates.iter().map(|r| r[0] / r[3]).collect());
-    let note = format!(
-        "{model}, camera rays in packets of {PACKET_RAYS} (8 × 8 tiles), Mrays/s (median of {runs}): grid packets {:.3}, grid single rays {:.3} (packets {single:.2}× as fast), Embree rtcIntersect1 {:.3}, Embree packets of {width} {:.3}",
+    let (ratio, lo, hi) = summary(rates.iter().map(|r| r[0] / r[2]).collect());
+    let row = format!(
+        "| {model} | {n} | camera-vs-{width} | {:.3} | {:.3} | – | {ratio:.2} ({lo:.2}–{hi:.2}) | – |",
         median(0),
-        median(3),
+        median(2)
+    );
+    let note = format!(
+        "{model}, camera rays (8 × 8 tiles), Mrays/s (median of {runs}): grid {:.3}, Embree rtcIntersect1 {:.3}, Embree packets of {width} {:.3}",
+        median(0),
         median(1),
         median(2)
     );
-    (
-        vec![
-            row("camera-packets", 1),
-            row(&format!("camera-packets-vs-{width}"), 2),
-        ],
-        note,
-    )
+    (row, note)
 }
 
 /// The medians over `runs` runs of the two figures `run_pair(run)` gives.
@@ -635,8 +617,8 @@ fn main() {
                 ));
             }
         }
-        let (rows, note) = packet_rows(model, n, &grid, &embree, &sets[1].1, runs);
-        rows.iter().for_each(|row| println!("{row}"));
+        let (row, note) = embree_packet_rows(model, n, &grid, &embree, &sets[1].1, runs);
+        println!("{row}");
         notes.push(note);
         // Scaling of the grid over all threads, best of 5, each timing the ray set traced
         // as many times over as make it last about 0.2 s on one thread (on the small

@@ -10,7 +10,7 @@ mod ray;
 mod top_level;
 mod triangle;
 
-pub use grid::{Grid, GridHit, GridStats, PACKET_RAYS, TraversalCounts, TraversalStats};
+pub use grid::{Grid, GridHit, GridStats, TraversalCounts, TraversalStats};
 pub use instances::{SceneAccel, SceneHit, TopLevel};
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};

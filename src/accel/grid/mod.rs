@@ -20,7 +20,6 @@ pub(crate) mod frame;
 mod storage;
 pub(crate) mod walk;
 
-pub use walk::packet::PACKET_RAYS;
 pub use walk::stats::{TraversalCounts, TraversalStats};
 
 use glam::{UVec3, Vec3};

@@ -144,9 +144,9 @@ fn light_segment(
 
 /// A pinhole camera's rays: from one point framing the box, through a square image whose
 /// side is a multiple of 8, tile by tile (8 × 8 pixels, the tiles row by row), as a
-/// renderer traces them and as packets take them ([`gridtrace::accel::PACKET_RAYS`]): every
-/// 64 rays from the first are one tile. The last rows are cut where `count` ends. (For the benchmark, the packet test and
-/// `tools/dev/grid-ab`; the cross-check does not use them.)
+/// renderer traces them and as packet queries take them: every 64 rays from the first are
+/// one tile. The last rows are cut where `count` ends. (For the benchmark and `tools/dev/grid-ab`;
+/// the cross-check does not use them.)
 #[allow(dead_code)]
 pub fn camera_rays(bounds: &Aabb, count: usize) -> Vec<Ray> {
     const TILE: usize = 8;

@@ -36,8 +36,7 @@
 //! block's word too, and order the triangles of each cell of several blocks so that a
 //! block's eight lie together ([`crate::accel::grid::build::block_order`]). When the walk finds such a cell
 //! whose box the ray meets, it tests the boxes of its blocks ([`block_mask`]) and asks
-//! memory for, and tests, only the blocks whose boxes the ray meets (thirty-first
-//! session). Answers are again those of the grid without boxes, but for ties between equal
+//! memory for, and tests, only the blocks whose boxes the ray meets. Answers are again those of the grid without boxes, but for ties between equal
 //! hits, which the order within a cell decides.
 
 use std::ops::Range;

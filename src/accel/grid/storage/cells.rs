@@ -288,12 +288,6 @@ impl CellIndex {
         }
     }
 
-    /// True when cell `c`'s macrocell is occupied (its word alone is read).
-    #[inline(always)]
-    pub fn macrocell_occupied(&self, c: IVec3) -> bool {
-        record_in(self.macro_words[self.macro_index(c >> MACRO_SHIFT)]).is_some()
-    }
-
     /// Starts loading what a ray moving into `octant` reads of record `record` (its
     /// occupancy, ranks and that octant's reaches) and the first two cache lines of its
     /// cells' offsets at once: the walk has just entered its macrocell and will read

@@ -10,7 +10,6 @@
 use glam::UVec3;
 
 pub(in crate::accel::grid) mod occupied;
-pub(crate) mod packet;
 pub(crate) mod prefetch;
 pub(in crate::accel::grid) mod stats;
 
