@@ -4,7 +4,7 @@ Run from the repository root after `cargo build --release`, with the PyPI `bpy` 
 (Blender as a Python module) and numpy and OpenEXR:
 
     pip install bpy==5.0.1 numpy OpenEXR
-    python3 tools/blender/efficiency.py [--spp 16 64] [--only NAME] [--gridtrace PATH]
+    python3 tools/blender/efficiency.py [--spp 16 64] [--only NAME] [--gridtrace PATH] [--guiding]
 
 For each reference scene of make_references.py (128x128, box filter, 64 bounces, black
 world, materials replaced by gridtrace's models), both renderers render it at each sample
@@ -14,7 +14,9 @@ tests/data/references), less the reference's own noise (the halves' squared diff
 time is the time spent sampling: gridtrace's reported render time (loading excluded), and
 for Cycles the time of the N-sample render less that of a 1-sample render (scene sync and
 BVH build), scaled by N / (N - 1). Efficiency is 1 / (MSE x time); the table gives both
-renderers' figures and their ratio (gridtrace / Cycles, higher is better).
+renderers' figures and their ratio (gridtrace / Cycles, higher is better). With
+`--guiding`, gridtrace also renders every measurement with `--guiding on` in the same run,
+and the table gains the guided figures and their ratio to Cycles.
 """
 
 import argparse
@@ -60,10 +62,10 @@ def cycles_render(scene, spp, seed, out):
     return time.perf_counter() - start
 
 
-def gridtrace_render(binary, scene_file, spp, seed, out):
+def gridtrace_render(binary, scene_file, spp, seed, out, guiding="off"):
     result = subprocess.run(
         [binary, scene_file, "-o", out, "--spp", str(spp), "--seed", str(seed),
-         "--max-depth", "64", "--width", "128", "--height", "128"],
+         "--max-depth", "64", "--width", "128", "--height", "128", "--guiding", guiding],
         capture_output=True, text=True, check=True)
     seconds = re.search(r" in ([0-9.]+) s:", result.stderr)
     return float(seconds.group(1))
@@ -80,7 +82,10 @@ def main():
     parser.add_argument("--only", action="append", help="scene name (repeatable)")
     parser.add_argument("--repeats", type=int, default=2, help="renders per measurement (seeds)")
     parser.add_argument("--gridtrace", default=os.path.join(ROOT, "target", "release", "gridtrace"))
+    parser.add_argument("--guiding", action="store_true",
+                        help="also render gridtrace with --guiding on, in the same run")
     args = parser.parse_args()
+    renderers = ("gridtrace", "guided", "cycles") if args.guiding else ("gridtrace", "cycles")
     names = [n for n, (_, _, s) in SCENE_TABLE.items() if s > 0 and (not args.only or n in args.only)]
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -95,14 +100,16 @@ def main():
             overhead = min(cycles_render(scene, 1, 100 + r, out) for r in range(args.repeats))
             for spp in args.spp:
                 measured = {}
-                for who in ("gridtrace", "cycles"):
+                for who in renderers:
                     errors, times = [], []
                     for r in range(args.repeats):
                         seed = 10 + r
                         if who == "cycles":
                             t = (cycles_render(scene, spp, seed, out) - overhead) * spp / (spp - 1)
                         else:
-                            t = gridtrace_render(args.gridtrace, scene_file(name), spp, seed, out)
+                            guiding = "on" if who == "guided" else "off"
+                            t = gridtrace_render(args.gridtrace, scene_file(name), spp, seed, out,
+                                                 guiding)
                         errors.append(max(np.mean((read_rgb(out) - ref) ** 2) - ref_noise, 1e-12))
                         times.append(max(t, 1e-3))
                     mse, seconds = float(np.mean(errors)), float(np.mean(times))
@@ -110,15 +117,22 @@ def main():
                 rows.append((name, spp, measured))
                 g, c = measured["gridtrace"], measured["cycles"]
                 print(f"{name} {spp} spp: gridtrace MSE {g[0]:.3g} in {g[1]:.2f} s, "
-                      f"Cycles MSE {c[0]:.3g} in {c[1]:.2f} s, efficiency ratio {g[2] / c[2]:.2f}",
+                      f"Cycles MSE {c[0]:.3g} in {c[1]:.2f} s, efficiency ratio {g[2] / c[2]:.2f}"
+                      + (f"; guided MSE {measured['guided'][0]:.3g} in {measured['guided'][1]:.2f} s, "
+                         f"efficiency ratio {measured['guided'][2] / c[2]:.2f}" if args.guiding else ""),
                       flush=True)
     print()
-    print("| scene | spp | gridtrace MSE | gridtrace s | Cycles MSE | Cycles s | MSE ratio (Cycles / gridtrace) | efficiency ratio (gridtrace / Cycles) |")
-    print("|---|---|---|---|---|---|---|---|")
+    guided_head = " guided MSE | guided s | guided efficiency ratio |" if args.guiding else ""
+    print("| scene | spp | gridtrace MSE | gridtrace s | Cycles MSE | Cycles s | MSE ratio (Cycles / gridtrace) | efficiency ratio (gridtrace / Cycles) |" + guided_head)
+    print("|---|---|---|---|---|---|---|---|" + ("---|---|---|" if args.guiding else ""))
     for name, spp, m in rows:
         g, c = m["gridtrace"], m["cycles"]
+        guided = ""
+        if args.guiding:
+            h = m["guided"]
+            guided = f" {h[0]:.3g} | {h[1]:.2f} | {h[2] / c[2]:.2f} |"
         print(f"| {name} | {spp} | {g[0]:.3g} | {g[1]:.2f} | {c[0]:.3g} | {c[1]:.2f} | "
-              f"{c[0] / g[0]:.2f} | {g[2] / c[2]:.2f} |")
+              f"{c[0] / g[0]:.2f} | {g[2] / c[2]:.2f} |" + guided)
     return 0
 
 
