@@ -215,20 +215,23 @@ impl Path {
         guiding: PathGuiding,
     ) -> bool {
         let s = vertex.surface;
-        let Some(sample) = scatter.sample(vertex.ns, vertex.wo, sampler) else {
+        let Some((sample, (guide_pdf, bsdf_pdf))) =
+            scatter.sample_with_densities(vertex.ns, vertex.wo, sampler)
+        else {
             return false;
         };
         let side = sample.wi.dot(vertex.ng);
         if (sample.is_transmission && side >= 0.0) || (!sample.is_transmission && side <= 0.0) {
             return false;
         }
+        let beta_before = self.beta;
         self.beta *= sample.weight;
         if matches!(guiding, PathGuiding::Train(_)) && scatter.guide.is_some() && !sample.is_delta {
             self.records.push(Guide::record(
                 vertex.region,
                 sample.wi,
-                sample.pdf,
-                self.beta,
+                (sample.pdf, guide_pdf, bsdf_pdf),
+                (beta_before, self.beta),
                 self.result.radiance,
             ));
         }
@@ -448,14 +451,25 @@ impl Renderer<'_> {
             -s.geometric_normal
         };
         let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo);
-        let (guide, region) = match asked.guiding.guide() {
+        let (guide, fraction, region) = match asked.guiding.guide() {
             Some(g) if bsdf.is_guidable() => {
-                let (distribution, region) = g.at(s.point);
-                (Some(distribution), region)
+                let (distribution, fraction, region) = g.at(s.point);
+                // A region whose share is 0 samples the BSDF alone, but goes on recording
+                // while training, to score the shares again.
+                let training = matches!(asked.guiding, PathGuiding::Train(_));
+                (
+                    (fraction > 0.0 || training).then_some(distribution),
+                    fraction,
+                    region,
+                )
             }
-            _ => (None, 0),
+            _ => (None, 0.0, 0),
         };
-        let scatter = GuidedBsdf { bsdf: &bsdf, guide };
+        let scatter = GuidedBsdf {
+            bsdf: &bsdf,
+            guide,
+            fraction,
+        };
 
         // Sample a light for the next-event estimate. Punctual lights can only be found
         // this way, so even the BSDF-only estimator samples them.

@@ -15,6 +15,7 @@
 //! samples first traces the training samples before it, so every sample is the same
 //! whichever process renders it, and split renders still merge exactly.
 
+mod fraction;
 mod mixture;
 mod quadtree;
 mod train;
@@ -27,6 +28,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::Vec3;
 
 use crate::geometry::Aabb;
+use fraction::Scores;
 use quadtree::{Distribution, Histogram};
 
 /// Whether paths are guided.
@@ -48,20 +50,25 @@ const SPLIT_RECORDS: f64 = 1000.0;
 /// Deepest level of the spatial tree.
 const MAX_SPATIAL_DEPTH: u32 = 24;
 
-/// One leaf of the spatial tree: the distribution paths draw from, the histogram that
-/// gathers the current pass's records, and how many records it took.
+/// One leaf of the spatial tree: the distribution paths draw from and the share of
+/// directions it proposes ([`fraction`]), the histogram and scores that gather the current
+/// pass's records, and how many records it took.
 #[derive(Debug)]
 struct Region {
     distribution: Distribution,
+    fraction: f32,
     histogram: Histogram,
+    scores: Scores,
     records: AtomicU64,
 }
 
 impl Region {
-    fn new(distribution: Distribution) -> Region {
+    fn new(distribution: Distribution, fraction: f32) -> Region {
         Region {
             histogram: distribution.refined(),
             distribution,
+            fraction,
+            scores: Scores::default(),
             records: AtomicU64::new(0),
         }
     }
@@ -89,9 +96,13 @@ pub struct Record {
     region: u32,
     /// The direction the path left the vertex in.
     direction: Vec3,
-    /// The density it was drawn with (the mixture's).
+    /// The density it was drawn with (the mixture's), and the guide's and the BSDF's
+    /// there.
     pdf: f32,
-    /// The throughput after the bounce at the vertex.
+    guide_pdf: f32,
+    bsdf_pdf: f32,
+    /// The throughput before and after the bounce at the vertex.
+    beta_before: Vec3,
     beta: Vec3,
     /// The path's radiance before anything the bounce found.
     radiance_before: Vec3,
@@ -111,7 +122,7 @@ impl Guide {
                 region: 0,
                 depth: 0,
             }],
-            regions: vec![Region::new(Distribution::uniform())],
+            regions: vec![Region::new(Distribution::uniform(), fraction::INITIAL)],
         }
     }
 
@@ -133,24 +144,31 @@ impl Guide {
         }
     }
 
-    /// The directional distribution at `point`, with the region's index for recording.
-    pub fn at(&self, point: Vec3) -> (&Distribution, u32) {
+    /// The directional distribution at `point` and the share of directions it proposes
+    /// there, with the region's index for recording.
+    pub fn at(&self, point: Vec3) -> (&Distribution, f32, u32) {
         let region = self.region_index(point);
-        (&self.regions[region as usize].distribution, region)
+        let r = &self.regions[region as usize];
+        (&r.distribution, r.fraction, region)
     }
 
-    /// A record of a bounce at a vertex of `region`, to be completed when the path ends.
+    /// A record of a bounce at a vertex of `region` in `direction`, drawn with density
+    /// `pdf` (the guide's `guide_pdf` and the BSDF's `bsdf_pdf` there), the throughput going
+    /// from `beta_before` to `beta`, to be completed when the path ends.
     pub fn record(
         region: u32,
         direction: Vec3,
-        pdf: f32,
-        beta: Vec3,
+        (pdf, guide_pdf, bsdf_pdf): (f32, f32, f32),
+        (beta_before, beta): (Vec3, Vec3),
         radiance_before: Vec3,
     ) -> Record {
         Record {
             region,
             direction,
             pdf,
+            guide_pdf,
+            bsdf_pdf,
+            beta_before,
             beta,
             radiance_before,
         }
@@ -160,27 +178,38 @@ impl Guide {
     /// after its bounce, divided by the throughput up to it (an estimate of the incident
     /// radiance from its direction) and by the density of that direction, so that a
     /// quadrant's sum estimates its integral of incident radiance (the paper's §3.3).
+    /// Divided by the throughput before the bounce instead, it is the vertex's estimate of
+    /// its own integral, which scores the region's shares ([`fraction`]).
     pub fn add_path(&self, records: &[Record], radiance: Vec3) {
+        let per = |gained: Vec3, beta: Vec3| {
+            Vec3::select(beta.cmpgt(Vec3::ZERO), gained / beta, Vec3::ZERO).element_sum() / 3.0
+        };
         for r in records {
             let gained = radiance - r.radiance_before;
-            let incident = Vec3::select(r.beta.cmpgt(Vec3::ZERO), gained / r.beta, Vec3::ZERO);
             let region = &self.regions[r.region as usize];
             region.records.fetch_add(1, Ordering::Relaxed);
             region
                 .histogram
-                .record(r.direction, incident.element_sum() / 3.0 / r.pdf);
+                .record(r.direction, per(gained, r.beta) / r.pdf);
+            let estimate = per(gained, r.beta_before);
+            region
+                .scores
+                .add(estimate, r.guide_pdf, r.bsdf_pdf, region.fraction);
         }
     }
 
     /// Ends training pass `pass` (from 0): every region samples what it gathered from now
-    /// on, regions with many records are split (their halves start from the same
-    /// distribution), and fresh histograms are made, refined where energy was found.
+    /// on, with the share its records scored best, regions with many records are split
+    /// (their halves start from the same distribution and share), and fresh histograms are
+    /// made, refined where energy was found.
     pub fn end_pass(&mut self, pass: u32) {
         for region in &mut self.regions {
             let learned = region.histogram.freeze();
             if !learned.is_uniform() {
                 region.distribution = learned;
             }
+            let records = region.records.load(Ordering::Relaxed);
+            region.fraction = region.scores.choose(records, region.fraction);
         }
         let limit = SPLIT_RECORDS * 2f64.powf(f64::from(pass) * 0.5);
         let mut node = 0;
@@ -192,6 +221,7 @@ impl Guide {
         }
         for region in &mut self.regions {
             region.histogram = region.distribution.refined();
+            region.scores = Scores::default();
             region.records.store(0, Ordering::Relaxed);
         }
     }
@@ -208,8 +238,9 @@ impl Guide {
         let axis = (depth % 3) as u8;
         let half = records / 2;
         let twin = self.regions.len() as u32;
-        let distribution = self.regions[region as usize].distribution.clone();
-        self.regions.push(Region::new(distribution));
+        let parent = &self.regions[region as usize];
+        let (distribution, fraction) = (parent.distribution.clone(), parent.fraction);
+        self.regions.push(Region::new(distribution, fraction));
         self.regions[region as usize]
             .records
             .store(half, Ordering::Relaxed);

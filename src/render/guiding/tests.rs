@@ -10,6 +10,9 @@ use crate::render::chi_square::sphere_z_score;
 use crate::render::sampler::Sampler;
 use crate::scene::Pbr;
 
+/// The guide's share in the mixtures tested (the paper's fixed α).
+const SHARE: f32 = 0.5;
+
 /// Radiance piled towards two directions, one below the horizon, over a faint floor.
 fn radiance(d: Vec3) -> f32 {
     let a = Vec3::new(0.3, -0.5, 0.81).normalize();
@@ -79,6 +82,7 @@ fn guided_bsdfs_sample_as_their_mixed_pdf_says() {
         let guided = GuidedBsdf {
             bsdf,
             guide: Some(&distribution),
+            fraction: SHARE,
         };
         for mu in [0.3f32, 0.9] {
             let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
@@ -87,8 +91,17 @@ fn guided_bsdfs_sample_as_their_mixed_pdf_says() {
                 400_000,
                 || {
                     i += 1;
-                    let s = guided.sample(n, wo, &mut Sampler::for_sample(3, 0, i as u32))?;
+                    let mut sampler = Sampler::for_sample(3, 0, i as u32);
+                    let (s, (guide_pdf, bsdf_pdf)) =
+                        guided.sample_with_densities(n, wo, &mut sampler)?;
                     let pdf = guided.pdf(n, wo, s.wi);
+                    // The densities a training record keeps are the guide's and the BSDF's.
+                    let expected = (distribution.pdf(s.wi), bsdf.pdf(n, wo, s.wi));
+                    assert!(
+                        (guide_pdf - expected.0).abs() <= 1e-3 * expected.0
+                            && (bsdf_pdf - expected.1).abs() <= 1e-3 * expected.1,
+                        "{name}: densities {guide_pdf}, {bsdf_pdf} vs {expected:?}"
+                    );
                     assert!(
                         (s.pdf - pdf).abs() <= 1e-3 * pdf,
                         "{name}: {} vs {pdf}",
@@ -129,6 +142,7 @@ fn the_mixed_pdf_integrates_to_the_bsdfs_share_plus_the_guides() {
     let guided = GuidedBsdf {
         bsdf: &bsdf,
         guide: Some(&distribution),
+        fraction: SHARE,
     };
     let wo = Vec3::new(0.6, 0.0, 0.8);
     let n = 512;
