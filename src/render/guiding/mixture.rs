@@ -26,8 +26,9 @@ impl GuidedBsdf<'_> {
     pub fn pdf(&self, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
         let bsdf = self.bsdf.pdf(n, wo, wi);
         match self.guide {
-            None => bsdf,
-            Some(guide) => self.mix(guide.pdf(wi), bsdf),
+            // A share of 0 (a region that only records, while training) needs no lookup.
+            Some(guide) if self.fraction > 0.0 => self.mix(guide.pdf(wi), bsdf),
+            _ => bsdf,
         }
     }
 
