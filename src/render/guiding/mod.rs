@@ -49,6 +49,8 @@ const SPLIT_RECORDS: f64 = 1000.0;
 
 /// Deepest level of the spatial tree.
 const MAX_SPATIAL_DEPTH: u32 = 24;
+// A region is found by reading one bit of a 32-bit fraction per level of an axis.
+const _: () = assert!(MAX_SPATIAL_DEPTH <= 3 * 32);
 
 /// One leaf of the spatial tree: the distribution paths draw from and the share of
 /// directions it proposes ([`fraction`]), the histogram and scores that gather the current
@@ -127,18 +129,26 @@ impl Guide {
     }
 
     /// The region holding `point` (points outside the bounds go to the nearest region).
+    /// Each inner node halves its box, so the way down is the binary digits of the point's
+    /// place in the bounds, one more digit of an axis at each node that splits it: read as
+    /// bits of a 32-bit fraction, with no arithmetic per level (the exact digits that
+    /// doubling the place and taking its whole part would give).
     fn region_index(&self, point: Vec3) -> u32 {
-        let mut p = ((point - self.bounds.min) / (self.bounds.max - self.bounds.min))
+        let p = ((point - self.bounds.min) / (self.bounds.max - self.bounds.min))
             .clamp(Vec3::ZERO, Vec3::splat(1.0 - f32::EPSILON));
+        let fraction = p
+            .to_array()
+            .map(|c| (f64::from(c) * 4_294_967_296.0) as u32);
+        let mut digits = [0u32; 3];
         let mut node = 0usize;
         loop {
             match self.nodes[node] {
                 SpatialNode::Leaf { region, .. } => return region,
                 SpatialNode::Inner { axis, children } => {
                     let a = axis as usize;
-                    let upper = p[a] >= 0.5;
-                    p[a] = (p[a] * 2.0 - f32::from(u8::from(upper))).clamp(0.0, 1.0 - f32::EPSILON);
-                    node = children[usize::from(upper)] as usize;
+                    let upper = (fraction[a] << digits[a]) >> 31;
+                    digits[a] += 1;
+                    node = children[upper as usize] as usize;
                 }
             }
         }
