@@ -7,9 +7,9 @@
 //! E = F/p_α₀ of its vertex's integral; the second moment with share α is
 //! ∫ F²/p_α = E_α₀[E²·p_α₀/p_α], so every candidate is scored from the same records. The
 //! least second moment is the least variance, since every share gives the same mean:
-//! any choice leaves the image unbiased, and regions where the guide only adds noise (a
-//! floor beneath a glass ball, which cosine sampling already aims at) fall back to the
-//! BSDF alone and skip the guide's lookups.
+//! any choice leaves the image unbiased, and a region where the guide only adds noise
+//! (where cosine sampling already aims at what lights it) can fall back to the BSDF alone
+//! and skip the guide's lookups.
 //!
 //! The scores are summed in 128-bit fixed point, exactly, so they — and the shares chosen —
 //! do not depend on the order in which threads add records.
