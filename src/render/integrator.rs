@@ -102,8 +102,6 @@ struct Vertex<'a> {
     entering: bool,
     /// The volume's absorption coefficient.
     absorption: Vec3,
-    /// The guide's region holding the vertex (0 when unguided).
-    region: u32,
 }
 
 /// The state a path carries from vertex to vertex.
@@ -228,7 +226,7 @@ impl Path {
         self.beta *= sample.weight;
         if matches!(guiding, PathGuiding::Train(_)) && scatter.guide.is_some() && !sample.is_delta {
             self.records.push(Guide::record(
-                vertex.region,
+                vertex.surface.point,
                 sample.wi,
                 (sample.pdf, guide_pdf, bsdf_pdf),
                 (beta_before, self.beta),
@@ -451,19 +449,18 @@ impl Renderer<'_> {
             -s.geometric_normal
         };
         let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo);
-        let (guide, fraction, region) = match asked.guiding.guide() {
+        let (guide, fraction) = match asked.guiding.guide() {
             Some(g) if bsdf.is_guidable() => {
-                let (distribution, fraction, region) = g.at(s.point);
+                let (distribution, fraction) = g.at(s.point);
                 // A region whose share is 0 samples the BSDF alone, but goes on recording
                 // while training, to score the shares again.
                 let training = matches!(asked.guiding, PathGuiding::Train(_));
                 (
                     (fraction > 0.0 || training).then_some(distribution),
                     fraction,
-                    region,
                 )
             }
-            _ => (None, 0.0, 0),
+            _ => (None, 0.0),
         };
         let scatter = GuidedBsdf {
             bsdf: &bsdf,
@@ -487,7 +484,6 @@ impl Renderer<'_> {
             wo,
             entering: front && material.absorption != Vec3::ZERO,
             absorption: material.absorption,
-            region,
         };
         path.extend(&vertex, &scatter, sampler, asked.guiding)
     }

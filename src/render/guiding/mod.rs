@@ -95,7 +95,8 @@ pub struct Guide {
 /// Where a guided vertex records what reached it, kept along the path until its end.
 #[derive(Clone, Copy, Debug)]
 pub struct Record {
-    region: u32,
+    /// Where the vertex lies.
+    point: Vec3,
     /// The direction the path left the vertex in.
     direction: Vec3,
     /// The density it was drawn with (the mixture's), and the guide's and the BSDF's
@@ -154,26 +155,69 @@ impl Guide {
         }
     }
 
-    /// The directional distribution at `point` and the share of directions it proposes
-    /// there, with the region's index for recording.
-    pub fn at(&self, point: Vec3) -> (&Distribution, f32, u32) {
-        let region = self.region_index(point);
-        let r = &self.regions[region as usize];
-        (&r.distribution, r.fraction, region)
+    /// The region a record is added to: the one at a point drawn uniformly from a box the
+    /// size of the record's own region centred on its vertex (the paper's §5.2 stochastic
+    /// box filter), so that records near a region's faces also teach its neighbours. The
+    /// point is drawn from numbers hashed from the record itself, so it does not depend on
+    /// which thread adds it.
+    fn splat_region(&self, r: &Record) -> u32 {
+        self.region_index(r.point + self.splat_offset(r))
     }
 
-    /// A record of a bounce at a vertex of `region` in `direction`, drawn with density
+    /// The offset of [`Guide::splat_region`]'s point from the record's vertex: uniform in a
+    /// box the size of the vertex's region, centred on it.
+    fn splat_offset(&self, r: &Record) -> Vec3 {
+        let size = self.region_size(r.point);
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        let [x, y, z] = bits(r.point);
+        let [a, b, c] = bits(r.direction);
+        let key = (u64::from(x) << 32 | u64::from(y))
+            ^ (u64::from(z) << 32 | u64::from(a))
+            ^ u64::from(b).rotate_left(17)
+            ^ u64::from(c).rotate_left(41);
+        let h = crate::render::sampling::mix64(key);
+        let unit = |shift: u32| ((h >> shift) & 0x1f_ffff) as f32 / 2_097_152.0 - 0.5;
+        Vec3::new(unit(0), unit(21), unit(42)) * size
+    }
+
+    /// The size of the region holding `point`.
+    fn region_size(&self, point: Vec3) -> Vec3 {
+        let extent = self.bounds.max - self.bounds.min;
+        let p =
+            ((point - self.bounds.min) / extent).clamp(Vec3::ZERO, Vec3::splat(1.0 - f32::EPSILON));
+        let fraction = p
+            .to_array()
+            .map(|c| (f64::from(c) * 4_294_967_296.0) as u32);
+        let mut digits = [0u32; 3];
+        let mut node = 0usize;
+        while let SpatialNode::Inner { axis, children } = self.nodes[node] {
+            let a = axis as usize;
+            let upper = (fraction[a] << digits[a]) >> 31;
+            digits[a] += 1;
+            node = children[upper as usize] as usize;
+        }
+        extent / Vec3::from(digits.map(|d| (1u32 << d) as f32))
+    }
+
+    /// The directional distribution at `point` and the share of directions it proposes
+    /// there.
+    pub fn at(&self, point: Vec3) -> (&Distribution, f32) {
+        let r = &self.regions[self.region_index(point) as usize];
+        (&r.distribution, r.fraction)
+    }
+
+    /// A record of a bounce at a vertex at `point` in `direction`, drawn with density
     /// `pdf` (the guide's `guide_pdf` and the BSDF's `bsdf_pdf` there), the throughput going
     /// from `beta_before` to `beta`, to be completed when the path ends.
     pub fn record(
-        region: u32,
+        point: Vec3,
         direction: Vec3,
         (pdf, guide_pdf, bsdf_pdf): (f32, f32, f32),
         (beta_before, beta): (Vec3, Vec3),
         radiance_before: Vec3,
     ) -> Record {
         Record {
-            region,
+            point,
             direction,
             pdf,
             guide_pdf,
@@ -196,7 +240,7 @@ impl Guide {
         };
         for r in records {
             let gained = radiance - r.radiance_before;
-            let region = &self.regions[r.region as usize];
+            let region = &self.regions[self.splat_region(r) as usize];
             region.records.fetch_add(1, Ordering::Relaxed);
             region
                 .histogram

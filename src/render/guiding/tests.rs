@@ -1,10 +1,11 @@
-//! χ² tests of the guide's sampling, alone and mixed with BSDFs, and of its training's
-//! independence from the order of records.
+//! χ² tests of the guide's sampling, alone and mixed with BSDFs, of its training's
+//! independence from the order of records, and of the spreading of records over regions.
 
 use glam::{Vec2, Vec3};
 
-use super::GuidedBsdf;
 use super::quadtree::{Distribution, to_sphere};
+use super::{Guide, GuidedBsdf, Record};
+use crate::geometry::Aabb;
 use crate::render::bsdf::Bsdf;
 use crate::render::chi_square::sphere_z_score;
 use crate::render::sampler::Sampler;
@@ -155,4 +156,45 @@ fn the_mixed_pdf_integrates_to_the_bsdfs_share_plus_the_guides() {
     }
     integral *= 4.0 * std::f64::consts::PI / (n * n) as f64;
     assert!((integral - 1.0).abs() < 5e-3, "∫ pdf = {integral}");
+}
+
+/// Records spread over the bounds split the spatial tree; each record is then added to the
+/// region at a point drawn within a box the size of its own region around its vertex,
+/// always the same point for the same record, and often in a neighbouring region.
+#[test]
+fn records_are_splatted_within_a_region_of_their_vertex() {
+    let mut guide = Guide::new(Aabb {
+        min: Vec3::ZERO,
+        max: Vec3::ONE,
+    });
+    let records: Vec<Record> = (0..20_000u32)
+        .map(|i| {
+            let mut sampler = Sampler::for_sample(5, 0, i);
+            let p = Vec3::new(sampler.uniform(), sampler.uniform(), sampler.uniform());
+            let w = Vec3::ONE;
+            Guide::record(p, Vec3::Z, (1.0, 1.0, 1.0), (w, w), Vec3::ZERO)
+        })
+        .collect();
+    guide.add_path(&records, Vec3::ONE);
+    guide.end_pass(0);
+    assert!(guide.regions.len() >= 16, "{} regions", guide.regions.len());
+    let mut moved = 0;
+    for r in &records {
+        let size = guide.region_size(r.point);
+        let offset = guide.splat_offset(r);
+        assert!(
+            offset.abs().cmple(0.5 * size).all(),
+            "offset {offset} for a region of {size}"
+        );
+        assert_eq!(offset, guide.splat_offset(r));
+        moved += usize::from(guide.splat_region(r) != guide.region_index(r.point));
+    }
+    // Between a unit cube of regions where every face leads to a neighbour (a uniform
+    // offset within ±½ a region moves 1 − (¾)³ = 37/64 of the records) and none: the
+    // bounds' own faces keep what crosses them.
+    let share = moved as f64 / records.len() as f64;
+    assert!(
+        share > 0.2 && share < 37.0 / 64.0,
+        "{share} of records moved"
+    );
 }
