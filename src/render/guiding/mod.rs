@@ -129,12 +129,13 @@ impl Guide {
         }
     }
 
-    /// The region holding `point` (points outside the bounds go to the nearest region).
-    /// Each inner node halves its box, so the way down is the binary digits of the point's
-    /// place in the bounds, one more digit of an axis at each node that splits it: read as
-    /// bits of a 32-bit fraction, with no arithmetic per level (the exact digits that
-    /// doubling the place and taking its whole part would give).
-    fn region_index(&self, point: Vec3) -> u32 {
+    /// The leaf holding `point` (points outside the bounds go to the nearest one): its
+    /// region, and how many times each axis was halved on the way down. Each inner node
+    /// halves its box, so the way down is the binary digits of the point's place in the
+    /// bounds, one more digit of an axis at each node that splits it: read as bits of a
+    /// 32-bit fraction, with no arithmetic per level (the exact digits that doubling the
+    /// place and taking its whole part would give).
+    fn leaf(&self, point: Vec3) -> (u32, [u32; 3]) {
         let p = ((point - self.bounds.min) / (self.bounds.max - self.bounds.min))
             .clamp(Vec3::ZERO, Vec3::splat(1.0 - f32::EPSILON));
         let fraction = p
@@ -144,7 +145,7 @@ impl Guide {
         let mut node = 0usize;
         loop {
             match self.nodes[node] {
-                SpatialNode::Leaf { region, .. } => return region,
+                SpatialNode::Leaf { region, .. } => return (region, digits),
                 SpatialNode::Inner { axis, children } => {
                     let a = axis as usize;
                     let upper = (fraction[a] << digits[a]) >> 31;
@@ -153,6 +154,11 @@ impl Guide {
                 }
             }
         }
+    }
+
+    /// The region holding `point`.
+    fn region_index(&self, point: Vec3) -> u32 {
+        self.leaf(point).0
     }
 
     /// The region a record is added to: the one at a point drawn uniformly from a box the
@@ -182,21 +188,8 @@ impl Guide {
 
     /// The size of the region holding `point`.
     fn region_size(&self, point: Vec3) -> Vec3 {
-        let extent = self.bounds.max - self.bounds.min;
-        let p =
-            ((point - self.bounds.min) / extent).clamp(Vec3::ZERO, Vec3::splat(1.0 - f32::EPSILON));
-        let fraction = p
-            .to_array()
-            .map(|c| (f64::from(c) * 4_294_967_296.0) as u32);
-        let mut digits = [0u32; 3];
-        let mut node = 0usize;
-        while let SpatialNode::Inner { axis, children } = self.nodes[node] {
-            let a = axis as usize;
-            let upper = (fraction[a] << digits[a]) >> 31;
-            digits[a] += 1;
-            node = children[upper as usize] as usize;
-        }
-        extent / Vec3::from(digits.map(|d| (1u32 << d) as f32))
+        let halvings = self.leaf(point).1;
+        (self.bounds.max - self.bounds.min) / Vec3::from(halvings.map(|d| (1u32 << d) as f32))
     }
 
     /// The directional distribution at `point` and the share of directions it proposes
