@@ -1,8 +1,8 @@
 //! A BSDF and a guiding distribution sampled as one mixture: with probability α, the
-//! region's share ([`super::fraction`]), the guide proposes the direction, otherwise the BSDF does, and the
-//! sample is weighed by the mixture's density (one-sample MIS with the balance heuristic,
-//! Veach 1997 §9.2.4, as the paper's §5 combines them). Next-event estimation sees the
-//! mixture's density too, so its MIS weights stay right.
+//! region's share ([`super::fraction`]), the guide proposes the direction, otherwise the
+//! BSDF does, and the sample is weighed by the mixture's density (one-sample MIS with the
+//! balance heuristic, Veach 1997 §9.2.4, as the paper's §5 combines them). Next-event
+//! estimation sees the mixture's density too, so its MIS weights stay right.
 
 use glam::{Vec2, Vec3};
 
@@ -21,8 +21,8 @@ pub struct GuidedBsdf<'a> {
 }
 
 impl GuidedBsdf<'_> {
-    /// Solid-angle density with which [`GuidedBsdf::sample_with_densities`] picks `wi` by its non-delta
-    /// strategies.
+    /// Solid-angle density with which [`GuidedBsdf::sample_with_densities`] picks `wi` by
+    /// its non-delta strategies.
     pub fn pdf(&self, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
         let bsdf = self.bsdf.pdf(n, wo, wi);
         match self.guide {
