@@ -21,7 +21,7 @@ mod shading;
 mod surface;
 
 pub use aov::{AovImage, AovSet, Features};
-pub use bsdf::{Bsdf, BsdfSample, fresnel_dielectric, warm_tables};
+pub use bsdf::{Bsdf, BsdfSample, fresnel_dielectric};
 pub use camera::RayGenerator;
 pub use coverage::{ViewCoverage, view_coverage};
 pub use film::{Film, Image, PixelAccumulator};

@@ -30,11 +30,6 @@ pub fn run_render(args: &Args, stop: &AtomicBool) -> Result<Outcome> {
     }
     let plan = plan::plan_outputs(args, request)?;
     let load_start = Instant::now();
-    // Parsing mostly keeps one core busy: the BSDF tables are integrated beside it,
-    // unless one thread was asked for.
-    if args.threads != Some(1) {
-        std::thread::spawn(crate::render::warm_tables);
-    }
     let prepared = prepare::prepare(args, &plan)?;
     // The workers start only now: a USD stage is first read in a forked child, and a
     // worker caught starting up at the fork (initialising a process-wide value its thread

@@ -43,14 +43,6 @@ use microfacet::Ggx;
 use sheen::SheenLayer;
 use specular::SpecularLobe;
 
-/// Integrates the albedo tables every layered or glass material needs (about 0.1 s of one
-/// core), so that a caller can do it beside work that leaves a core idle, such as parsing
-/// a scene; the first material that needs them otherwise waits for them.
-pub fn warm_tables() {
-    albedo::tables();
-    albedo::glass_table();
-}
-
 /// Index of the clear coat: 1.5, as `KHR_materials_clearcoat` fixes it (F0 = 0.04) and as
 /// Cycles' coat defaults.
 const COAT_IOR: f32 = 1.5;
