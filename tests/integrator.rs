@@ -607,12 +607,16 @@ fn glass_made_by_a_metallic_texture_is_glass_inside_too() {
             .0
     };
     let (textured, constant) = (render(true), render(false));
-    // Below the ball's centre the floor is seen through it.
-    let through = |image: &Image| image.pixel(16, 20);
+    // Below the ball's centre the floor is seen through it, lit only by the few paths that
+    // reach the light back through the ball: many of those 56 pixels catch one at 16
+    // samples, none would behind an opaque black inside.
+    let lit = (12..20)
+        .flat_map(|x| (17..24).map(move |y| (x, y)))
+        .filter(|&(x, y)| constant.pixel(x, y).min_element() > 0.0)
+        .count();
     assert!(
-        through(&constant).min_element() > 0.005,
-        "the floor is not seen through constant glass: {}",
-        through(&constant)
+        lit >= 10,
+        "the floor is not seen through constant glass: {lit} of 56 pixels lit"
     );
     let differing = (0..32 * 32)
         .filter(|&i| textured.pixels[i] != constant.pixels[i])

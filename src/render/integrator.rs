@@ -377,7 +377,7 @@ impl Renderer<'_> {
             t_max,
             path.depth == 0,
             |l, light_pdf, t| {
-                let weight = emission_weight(arrival, strategy, light_pdf);
+                let weight = emission_weight(arrival, strategy, || light_pdf);
                 let through = medium.map_or(Vec3::ONE, |sigma| (-sigma * t).exp());
                 *radiance += weight * beta * through * l;
             },
@@ -400,7 +400,7 @@ impl Renderer<'_> {
             };
         }
         if environment != Vec3::ZERO {
-            let weight = emission_weight(path.arrival, strategy, light_pdf);
+            let weight = emission_weight(path.arrival, strategy, || light_pdf);
             path.result.radiance += weight * path.beta * environment;
         }
     }
@@ -579,26 +579,28 @@ impl Renderer<'_> {
         strategy: Strategy,
     ) -> f32 {
         let (vertex, vertex_normal, travelled) = from;
-        let light_pdf = self.lights.pdf(
-            hit.instance,
-            hit.triangle,
-            hit.time,
-            vertex,
-            vertex_normal,
-            travelled,
-            cos_o,
-        );
-        emission_weight(arrival, strategy, light_pdf)
+        emission_weight(arrival, strategy, || {
+            self.lights.pdf(
+                hit.instance,
+                hit.triangle,
+                hit.time,
+                vertex,
+                vertex_normal,
+                travelled,
+                cos_o,
+            )
+        })
     }
 }
 
 /// The weight of emission found by a ray that arrived as `arrival`, from a light that
-/// light sampling would have drawn with solid-angle density `light_pdf`: full after the
+/// light sampling would have drawn with solid-angle density `light_pdf()`: full after the
 /// camera or a delta lobe, and otherwise as the strategy says (the power heuristic for MIS).
-fn emission_weight(arrival: Arrival, strategy: Strategy, light_pdf: f32) -> f32 {
+/// The density, a walk of the light tree, is worked out only for MIS.
+fn emission_weight(arrival: Arrival, strategy: Strategy, light_pdf: impl FnOnce() -> f32) -> f32 {
     match (arrival, strategy) {
         (Arrival::Specular, _) | (_, Strategy::BsdfOnly) => 1.0,
         (Arrival::Scattered { .. }, Strategy::LightOnly) => 0.0,
-        (Arrival::Scattered { pdf }, Strategy::Mis) => power_heuristic(pdf, light_pdf),
+        (Arrival::Scattered { pdf }, Strategy::Mis) => power_heuristic(pdf, light_pdf()),
     }
 }

@@ -3,8 +3,12 @@
 //! towards the triangle is equally likely, so a large or near light is sampled without the
 //! distance² / cos weight that makes area sampling noisy up close.
 //!
-//! Very small triangles gain nothing and lose precision; nearly hemispherical ones are
-//! unstable: outside [`MIN_SOLID_ANGLE`, `MAX_SOLID_ANGLE`] a triangle is sampled by area
+//! A triangle far from the point, compared with its size, gains nothing: its distance² /
+//! cos weight hardly varies over it, and working out its solid angle costs more than the
+//! rest of the light sample. Such a triangle (its longest edge shorter than its plane's
+//! distance from the point, Cycles' rule in `kernel/light/triangle.h`) is sampled by area.
+//! Very small solid angles lose precision and nearly hemispherical ones are unstable:
+//! outside [`MIN_SOLID_ANGLE`, `MAX_SOLID_ANGLE`] a triangle is sampled by area too
 //! (pbrt-v4's thresholds). The choice depends only on the shading point and the triangle,
 //! so the density that MIS weighs a hit with is the one the sample was drawn with.
 
@@ -22,6 +26,7 @@ pub fn directions(p: Vec3, corners: [Vec3; 3]) -> [DVec3; 3] {
 }
 
 /// The solid angle triangle `corners` subtends at `p`.
+#[cfg(test)]
 pub fn solid_angle(p: Vec3, corners: [Vec3; 3]) -> f64 {
     solid_angle_of(directions(p, corners))
 }
@@ -40,9 +45,34 @@ pub fn solid_angle_of([a, b, c]: [DVec3; 3]) -> f64 {
     }
 }
 
-/// True when the triangle is sampled by solid angle from there.
+/// True when a triangle of solid angle `omega` is sampled by solid angle, if near.
 pub fn use_solid_angle(omega: f64) -> bool {
     (MIN_SOLID_ANGLE..=MAX_SOLID_ANGLE).contains(&omega)
+}
+
+/// How triangle `corners` is sampled from `p`: by solid angle, with the corners'
+/// [`directions`] and the solid angle, when it is near and [`use_solid_angle`] agrees;
+/// `None`: by area.
+pub fn by_solid_angle(p: Vec3, corners: [Vec3; 3]) -> Option<([DVec3; 3], f64)> {
+    if !is_near(p, corners) {
+        return None;
+    }
+    let directions = directions(p, corners);
+    let omega = solid_angle_of(directions);
+    use_solid_angle(omega).then_some((directions, omega))
+}
+
+/// True when the triangle's longest edge is longer than the distance from `p` to its
+/// plane: (n · (v0 − p))² < longest² · |n|² with n the unnormalised normal, no division.
+fn is_near(p: Vec3, [v0, v1, v2]: [Vec3; 3]) -> bool {
+    let (e0, e1, e2) = (v1 - v0, v2 - v0, v2 - v1);
+    let longest = e0
+        .length_squared()
+        .max(e1.length_squared())
+        .max(e2.length_squared());
+    let n = e0.cross(e1);
+    let height = n.dot(v0 - p);
+    height * height < longest * n.length_squared()
 }
 
 /// A direction from `p` uniform over the solid angle of triangle `corners`, whose solid

@@ -206,13 +206,12 @@ impl EmissiveTriangles {
             return None;
         }
         let corners = placed.corners.map(|c| c.0);
-        let directions = spherical::directions(p, corners);
-        let omega = spherical::solid_angle_of(directions);
-        let by_solid_angle = spherical::use_solid_angle(omega);
-        let b = if by_solid_angle {
-            spherical::sample_from(p, corners, directions, omega, u)?.1
-        } else {
-            uniform_triangle(u)
+        let by_solid_angle = spherical::by_solid_angle(p, corners);
+        let b = match by_solid_angle {
+            Some((directions, omega)) => {
+                spherical::sample_from(p, corners, directions, omega, u)?.1
+            }
+            None => uniform_triangle(u),
         };
         let (point, point_error) =
             interpolate_with_error(placed.corners, [1.0 - b.x - b.y, b.x, b.y]);
@@ -227,10 +226,9 @@ impl EmissiveTriangles {
         if cos_light == 0.0 {
             return None;
         }
-        let pdf = if by_solid_angle {
-            pmf / omega as f32
-        } else {
-            pmf / placed.area * distance_sq / cos_light.abs()
+        let pdf = match by_solid_angle {
+            Some((_, omega)) => pmf / omega as f32,
+            None => pmf / placed.area * distance_sq / cos_light.abs(),
         };
         let mut radiance = if tri.double_sided || cos_light > 0.0 {
             tri.radiance
@@ -284,8 +282,7 @@ impl EmissiveTriangles {
         if pmf == 0.0 {
             return 0.0;
         }
-        let omega = spherical::solid_angle(origin, placed.corners.map(|c| c.0));
-        if spherical::use_solid_angle(omega) {
+        if let Some((_, omega)) = spherical::by_solid_angle(origin, placed.corners.map(|c| c.0)) {
             return pmf / omega as f32;
         }
         pmf / placed.area * distance * distance / cos_light.abs()
