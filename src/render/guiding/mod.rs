@@ -44,7 +44,7 @@ pub enum Guiding {
 /// A region splits once one pass gave it more records than this times √(2^pass) (the
 /// paper's c = 12,000, lowered for the smaller images and shorter training here: 1,000
 /// lowered the error on the lamp shade by a fifth against 4,000, measured with
-/// tools/dev/guiding_efficiency.py).
+/// tools/dev/efficiency_ab.py).
 const SPLIT_RECORDS: f64 = 1000.0;
 
 /// Deepest level of the spatial tree.
