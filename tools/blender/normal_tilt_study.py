@@ -1,0 +1,88 @@
+"""How far gridtrace's normal-mapped diffuse departs from Cycles' as the map tilts the normal.
+
+Run from the repository root after `cargo build --release`, with the PyPI `bpy` package
+(Blender as a Python module), numpy and OpenEXR (the Blender virtual environment has all):
+
+    .blender-venv/bin/python tools/blender/normal_tilt_study.py [--tilts none 0 5 15 45] [--spp 1024]
+
+For each tilt, builds principled_normals' room with its two panels (Blender's default
+material, base colour (0.8, 0.7, 0.5)) normal-mapped by that many degrees away from the
+camera ("none": no normal map; 0: a flat map), exports it through Blender's glTF exporter,
+renders it with Cycles and with gridtrace at the same samples (128×128, box filter, 64
+bounces) and prints each panel's mean over Cycles', per channel. Files go to a temporary
+folder.
+"""
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import OpenEXR
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import make_principled as principled  # noqa: E402
+from make_cornell import export, quad, reset  # noqa: E402
+from make_references import ROOT, SIZE, render  # noqa: E402
+
+# Pixel rows and columns of each panel and of the wall, in the 128×128 image.
+REGIONS = {"left panel": (80, 108, 8, 56), "right panel": (80, 108, 72, 120), "wall": (8, 40, 0, 128)}
+
+
+def build(scene, tilt):
+    """The room and two panels mapped `tilt` degrees away from the camera (None: no map)."""
+    principled.room(scene)
+    for name, x0 in (("Left", -1.7), ("Right", 0.1)):
+        mat = principled.blender_default(name, (0.8, 0.7, 0.5))
+        if tilt is not None:
+            t = math.radians(tilt)
+            texel = (0.5, 0.5 + 0.5 * math.sin(t), 0.5 + 0.5 * math.cos(t), 1.0)
+            nodes, links = mat.node_tree.nodes, mat.node_tree.links
+            tex = nodes.new("ShaderNodeTexImage")
+            tex.image = principled.make_image(f"tilt_{name}", 4, lambda u, v, texel=texel: texel, "Non-Color")
+            tex.interpolation = "Closest"
+            normal_map = nodes.new("ShaderNodeNormalMap")
+            links.new(tex.outputs["Color"], normal_map.inputs["Color"])
+            links.new(normal_map.outputs["Normal"], nodes["Principled BSDF"].inputs["Normal"])
+        obj = quad(name, [(x0, -2.0, 0.01), (x0 + 1.6, -2.0, 0.01), (x0 + 1.6, 0.5, 0.01), (x0, 0.5, 0.01)], mat)
+        uv = obj.data.uv_layers.new(name="UVMap")
+        for loop, coord in zip(obj.data.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
+            uv.data[loop.index].uv = coord
+
+
+def read_rgb(path):
+    channels = OpenEXR.File(path).parts[0].channels
+    key = "RGBA" if "RGBA" in channels else "RGB"
+    return np.asarray(channels[key].pixels, dtype=np.float64)[..., :3]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--tilts", nargs="+", default=["none", "0", "5", "15", "45"])
+    parser.add_argument("--spp", type=int, default=1024)
+    parser.add_argument("--gridtrace", default=os.path.join(ROOT, "target", "release", "gridtrace"))
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as work:
+        for label in args.tilts:
+            scene = reset()
+            build(scene, None if label == "none" else float(label))
+            glb = os.path.join(work, f"tilt_{label}.glb")
+            export(glb)
+            cycles = os.path.join(work, f"tilt_{label}_cycles.exr")
+            render(scene, cycles, args.spp, 1, False, ("BOX", 1.0))
+            ours = os.path.join(work, f"tilt_{label}_gridtrace.exr")
+            subprocess.run([args.gridtrace, glb, "-o", ours, "-q", "--spp", str(args.spp),
+                            "--width", str(SIZE), "--height", str(SIZE), "--max-depth", "64",
+                            "--filter", "box"], check=True)
+            g, c = read_rgb(ours), read_rgb(cycles)
+            for region, (y0, y1, x0, x1) in REGIONS.items():
+                ratio = g[y0:y1, x0:x1].mean(axis=(0, 1)) / c[y0:y1, x0:x1].mean(axis=(0, 1))
+                print(f"tilt {label}: {region} gridtrace / Cycles {np.round(ratio, 4)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
