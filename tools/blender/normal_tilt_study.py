@@ -4,7 +4,7 @@ Run from the repository root after `cargo build --release`, with the PyPI `bpy` 
 (Blender as a Python module), numpy and OpenEXR (the Blender virtual environment has all):
 
     .blender-venv/bin/python tools/blender/normal_tilt_study.py [--tilts none 0 5 15 45] [--spp 1024]
-    .blender-venv/bin/python tools/blender/normal_tilt_study.py --furnace [--spp 1024]
+    .blender-venv/bin/python tools/blender/normal_tilt_study.py --furnace black|white [--spp 1024]
 
 For each tilt, builds principled_normals' room with its two panels (Blender's default
 material, base colour (0.8, 0.7, 0.5)) normal-mapped by that many degrees away from the
@@ -13,10 +13,13 @@ renders it with Cycles and with gridtrace at the same samples (128×128, box fil
 bounces) and prints each panel's mean over Cycles', per channel. Files go to a temporary
 folder.
 
-With `--furnace`, renders instead a black Principled ball of Blender's defaults (the 4 %
-specular layer alone) in a white world, seen from far away, and prints both renderers'
+With `--furnace black`, renders instead a black Principled ball of Blender's defaults (the
+4 % specular layer alone) in a white world, seen from far away, and prints both renderers'
 radiance by the cosine μ between the view and the surface: the share of light the
-specular layer keeps at each viewing angle, which a diffuse base beneath does not receive.
+specular layer keeps at each viewing angle. With `--furnace white` the ball is white, and
+a renderer that conserves energy shows 1 at every angle: what it falls short of 1 is what
+its diffuse base loses beyond what the layer above keeps. (Bins below μ = 0.2 hold the
+silhouette's pixels, which the white world partly covers.)
 """
 
 import argparse
@@ -79,10 +82,11 @@ def render_both(scene, work, label, spp, binary, extra=()):
     return read_rgb(ours), read_rgb(cycles)
 
 
-def furnace(work, spp, binary):
-    """The black ball in a white world, by viewing angle."""
+def furnace(work, spp, binary, base):
+    """A ball of base colour `base` (0 or 1) in a white world, by viewing angle."""
     scene = reset()
-    sphere("Ball", principled.blender_default("Black", (0.0, 0.0, 0.0)), 1.0, (0.0, 0.0, 0.0))
+    colour = (base, base, base)
+    sphere("Ball", principled.blender_default("Ball", colour), 1.0, (0.0, 0.0, 0.0))
     distance, fov = 60.0, 2.0
     add_camera(scene, (0.0, -distance, 0.0), (0.0, 0.0, 0.0), fov)
     world = bpy.data.worlds.new("White")
@@ -106,11 +110,12 @@ def main():
     parser.add_argument("--tilts", nargs="+", default=["none", "0", "5", "15", "45"])
     parser.add_argument("--spp", type=int, default=1024)
     parser.add_argument("--gridtrace", default=os.path.join(ROOT, "target", "release", "gridtrace"))
-    parser.add_argument("--furnace", action="store_true", help="the black ball in a white world")
+    parser.add_argument("--furnace", choices=["black", "white"],
+                        help="a black or white ball in a white world instead of the panels")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as work:
         if args.furnace:
-            furnace(work, args.spp, args.gridtrace)
+            furnace(work, args.spp, args.gridtrace, 1.0 if args.furnace == "white" else 0.0)
             return 0
         for label in args.tilts:
             scene = reset()
