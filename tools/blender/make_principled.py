@@ -183,17 +183,14 @@ def build_glass_tints(scene):
     sphere("TexturedBall", textured_glass, 0.35, (1.2, -0.3, 0.6))
 
 
-def build_normals(scene):
-    """Shading normals that face away from the viewer: two floor panels whose normal maps
-    lean 15° and 45° away from the camera (the camera sees the 45° panel from below its
-    tilted normal's horizon), and a coarse smooth-shaded metal ball, whose interpolated
-    normals turn away from the camera along its outline."""
-    room(scene)
-    for name, degrees, x0 in (("Tilt15", 15, -1.7), ("Tilt45", 45, 0.1)):
+def normal_mapped_panel(name, x0, degrees):
+    """A floor panel of Blender's default material (base colour (0.8, 0.7, 0.5)) from x0 to
+    x0 + 1.6, whose normal map leans `degrees` away from the camera (None: no normal map)."""
+    mat = blender_default(name, (0.8, 0.7, 0.5))
+    if degrees is not None:
         t = math.radians(degrees)
         # Tangent space: +Y follows the V coordinate, which runs away from the camera.
         texel = (0.5, 0.5 + 0.5 * math.sin(t), 0.5 + 0.5 * math.cos(t), 1.0)
-        mat = blender_default(name, (0.8, 0.7, 0.5))
         nodes, links = mat.node_tree.nodes, mat.node_tree.links
         tex = nodes.new("ShaderNodeTexImage")
         tex.image = make_image(f"normal_{degrees}", 4, lambda u, v, texel=texel: texel, "Non-Color")
@@ -201,10 +198,20 @@ def build_normals(scene):
         normal_map = nodes.new("ShaderNodeNormalMap")
         links.new(tex.outputs["Color"], normal_map.inputs["Color"])
         links.new(normal_map.outputs["Normal"], nodes["Principled BSDF"].inputs["Normal"])
-        obj = quad(name, [(x0, -2.0, 0.01), (x0 + 1.6, -2.0, 0.01), (x0 + 1.6, 0.5, 0.01), (x0, 0.5, 0.01)], mat)
-        uv = obj.data.uv_layers.new(name="UVMap")
-        for loop, coord in zip(obj.data.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
-            uv.data[loop.index].uv = coord
+    obj = quad(name, [(x0, -2.0, 0.01), (x0 + 1.6, -2.0, 0.01), (x0 + 1.6, 0.5, 0.01), (x0, 0.5, 0.01)], mat)
+    uv = obj.data.uv_layers.new(name="UVMap")
+    for loop, coord in zip(obj.data.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
+        uv.data[loop.index].uv = coord
+
+
+def build_normals(scene):
+    """Shading normals that face away from the viewer: two floor panels whose normal maps
+    lean 15° and 45° away from the camera (the camera sees the 45° panel from below its
+    tilted normal's horizon), and a coarse smooth-shaded metal ball, whose interpolated
+    normals turn away from the camera along its outline."""
+    room(scene)
+    for name, degrees, x0 in (("Tilt15", 15, -1.7), ("Tilt45", 45, 0.1)):
+        normal_mapped_panel(name, x0, degrees)
     bpy.ops.mesh.primitive_uv_sphere_add(segments=10, ring_count=6, radius=0.45, location=(0.0, 0.9, 0.6))
     ball = bpy.context.active_object
     ball.name = "CoarseBall"

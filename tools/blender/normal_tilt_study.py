@@ -35,7 +35,7 @@ import OpenEXR
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import make_principled as principled  # noqa: E402
-from make_cornell import export, quad, reset, sphere  # noqa: E402
+from make_cornell import export, reset, sphere  # noqa: E402
 from make_references import ROOT, SIZE, add_camera, render  # noqa: E402
 
 # Pixel rows and columns of each panel and of the wall, in the 128×128 image.
@@ -46,21 +46,7 @@ def build(scene, tilt):
     """The room and two panels mapped `tilt` degrees away from the camera (None: no map)."""
     principled.room(scene)
     for name, x0 in (("Left", -1.7), ("Right", 0.1)):
-        mat = principled.blender_default(name, (0.8, 0.7, 0.5))
-        if tilt is not None:
-            t = math.radians(tilt)
-            texel = (0.5, 0.5 + 0.5 * math.sin(t), 0.5 + 0.5 * math.cos(t), 1.0)
-            nodes, links = mat.node_tree.nodes, mat.node_tree.links
-            tex = nodes.new("ShaderNodeTexImage")
-            tex.image = principled.make_image(f"tilt_{name}", 4, lambda u, v, texel=texel: texel, "Non-Color")
-            tex.interpolation = "Closest"
-            normal_map = nodes.new("ShaderNodeNormalMap")
-            links.new(tex.outputs["Color"], normal_map.inputs["Color"])
-            links.new(normal_map.outputs["Normal"], nodes["Principled BSDF"].inputs["Normal"])
-        obj = quad(name, [(x0, -2.0, 0.01), (x0 + 1.6, -2.0, 0.01), (x0 + 1.6, 0.5, 0.01), (x0, 0.5, 0.01)], mat)
-        uv = obj.data.uv_layers.new(name="UVMap")
-        for loop, coord in zip(obj.data.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
-            uv.data[loop.index].uv = coord
+        principled.normal_mapped_panel(name, x0, tilt)
 
 
 def read_rgb(path):
