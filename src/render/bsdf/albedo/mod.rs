@@ -33,8 +33,18 @@ pub struct AlbedoTables {
 
 /// The process's tables, read from the shipped ones on first use.
 pub fn tables() -> &'static AlbedoTables {
-    static TABLES: OnceLock<AlbedoTables> = OnceLock::new();
-    TABLES.get_or_init(|| shipped::decode().0)
+    &shipped_tables().0
+}
+
+/// The process's glass table, read from the shipped one on first use.
+pub fn glass_table() -> &'static GlassTable {
+    &shipped_tables().1
+}
+
+/// Both tables, decoded together once: they share one shipped file.
+fn shipped_tables() -> &'static (AlbedoTables, GlassTable) {
+    static TABLES: OnceLock<(AlbedoTables, GlassTable)> = OnceLock::new();
+    TABLES.get_or_init(shipped::decode)
 }
 
 impl AlbedoTables {
@@ -68,12 +78,6 @@ pub struct GlassTable {
     values: Vec<Vec2>,
     /// Cosine-weighted average of the exact Fresnel reflectance per ior, from outside.
     fresnel_average: Vec<f32>,
-}
-
-/// The process's glass table, read from the shipped one on first use.
-pub fn glass_table() -> &'static GlassTable {
-    static TABLE: OnceLock<GlassTable> = OnceLock::new();
-    TABLE.get_or_init(|| shipped::decode().1)
 }
 
 impl GlassTable {
