@@ -7,10 +7,12 @@ mod estimates;
 #[path = "support/shapes/mod.rs"]
 mod shapes;
 
-use estimates::{assert_matches, estimate};
+use estimates::{assert_matches, estimate, estimate_with};
 use glam::{Affine3A, DVec3, Vec3};
 use gridtrace::accel::Ray;
-use gridtrace::render::{RenderSettings, Renderer, Strategy};
+use gridtrace::render::{
+    NextEvent, NextEventOdds, Outcome, PathOptions, RenderSettings, Renderer, Strategy,
+};
 use gridtrace::scene::{
     AlphaMode, Light, LightKind, Material, Pbr, Scene, SceneBuilder, Texture, TextureRef,
 };
@@ -35,11 +37,8 @@ fn rectangle_factor(x0: f64, x1: f64, z0: f64, z1: f64, h: f64) -> f64 {
 }
 
 /// A Lambertian floor of albedo ρ at y = 0 under a downward-facing square emitter of
-/// radiance L at height h: the floor's radiance is ρ/π · E with E = π·L·F, F the
-/// configuration factor to the emitter.
-#[test]
-fn floor_under_a_rectangular_light_matches_the_configuration_factor() {
-    let (albedo, radiance, h, half) = (0.6f32, Vec3::new(3.0, 2.0, 1.0), 1.0f32, 0.4f32);
+/// radiance L at height `LIGHT_HEIGHT`: the scene.
+fn floor_under_a_square_light(albedo: f32, radiance: Vec3, half: f32) -> Scene {
     let mut b = SceneBuilder::new();
     let floor = b.add_material(Material::diffuse("floor", Vec3::splat(albedo)));
     let light = b.add_material(Material {
@@ -57,6 +56,7 @@ fn floor_under_a_rectangular_light_matches_the_configuration_factor() {
         ],
         floor,
     );
+    let h = LIGHT_HEIGHT;
     add_quad(
         &mut b,
         [
@@ -67,25 +67,83 @@ fn floor_under_a_rectangular_light_matches_the_configuration_factor() {
         ],
         light,
     );
-    let scene = b.build();
+    b.build()
+}
 
-    // Under the centre, under a corner and well outside the light's footprint.
-    for (x, z) in [(0.0f32, 0.0f32), (half, half), (1.3, -0.7)] {
-        let (x0, x1) = ((-half - x) as f64, (half - x) as f64);
-        let (z0, z1) = ((-half - z) as f64, (half - z) as f64);
-        let factor = rectangle_factor(x0, x1, z0, z1, h as f64);
-        let expected = radiance.as_dvec3() * albedo as f64 * factor;
-        // Look at the floor point from the side, below the light's height.
-        let target = v(x, 0.0, z);
-        let origin = target + v(4.0, 0.5, 0.3);
-        let ray = Ray::new(origin, target - origin);
+const LIGHT_HEIGHT: f32 = 1.0;
+
+/// Points of the floor under the square light, and the floor's radiance there: ρ/π · E
+/// with E = π·L·F, F the configuration factor to the emitter; with the ray that looks at
+/// each from the side, below the light's height. Under the centre, under a corner and well
+/// outside the light's footprint.
+fn floor_points(albedo: f32, radiance: Vec3, half: f32) -> Vec<(Vec3, Ray, DVec3)> {
+    [(0.0f32, 0.0f32), (half, half), (1.3, -0.7)]
+        .into_iter()
+        .map(|(x, z)| {
+            let (x0, x1) = ((-half - x) as f64, (half - x) as f64);
+            let (z0, z1) = ((-half - z) as f64, (half - z) as f64);
+            let factor = rectangle_factor(x0, x1, z0, z1, LIGHT_HEIGHT as f64);
+            let expected = radiance.as_dvec3() * albedo as f64 * factor;
+            let target = Vec3::new(x, 0.0, z);
+            let origin = target + Vec3::new(4.0, 0.5, 0.3);
+            (target, Ray::new(origin, target - origin), expected)
+        })
+        .collect()
+}
+
+/// The floor under a square light has the radiance of the configuration factor.
+#[test]
+fn floor_under_a_rectangular_light_matches_the_configuration_factor() {
+    let (albedo, radiance, half) = (0.6f32, Vec3::new(3.0, 2.0, 1.0), 0.4f32);
+    let scene = floor_under_a_square_light(albedo, radiance, half);
+    for (target, ray, expected) in floor_points(albedo, radiance, half) {
         for strategy in STRATEGIES {
             let estimate = estimate(&scene, ray, strategy, 200_000);
             assert_matches(
-                &format!("floor at ({x}, {z}), {strategy:?}"),
+                &format!("floor at {target}, {strategy:?}"),
                 estimate,
                 expected,
                 0.02,
+            );
+        }
+    }
+}
+
+/// Next-event roulette leaves every estimator unbiased: with odds taught that no light
+/// sample ever reaches the floor (wrongly), the floor under the light still has the
+/// radiance of the configuration factor — light samples are taken rarely and weighed up,
+/// and MIS counts the odds in the light's density.
+#[test]
+fn next_event_roulette_with_wrong_odds_keeps_the_floor_exact() {
+    let (albedo, radiance, half) = (0.6f32, Vec3::new(3.0, 2.0, 1.0), 0.4f32);
+    let scene = floor_under_a_square_light(albedo, radiance, half);
+    let mut outcomes = Vec::new();
+    for i in 0..80 {
+        for j in 0..80 {
+            let point = Vec3::new(i as f32 / 20.0 - 2.0, 0.0, j as f32 / 20.0 - 2.0);
+            outcomes.push(Outcome {
+                point,
+                reached: false,
+            });
+        }
+    }
+    let odds = NextEventOdds::learn(outcomes);
+    for (target, ray, expected) in floor_points(albedo, radiance, half) {
+        assert!(
+            odds.at(target) < 1.0,
+            "the odds at {target} are not lowered"
+        );
+        for strategy in STRATEGIES {
+            let options = PathOptions {
+                next_event: NextEvent::Roulette(&odds),
+                ..PathOptions::plain(64, strategy)
+            };
+            let estimate = estimate_with(&scene, ray, options, 200_000);
+            assert_matches(
+                &format!("floor at {target}, {strategy:?}, roulette"),
+                estimate,
+                expected,
+                0.03,
             );
         }
     }

@@ -460,6 +460,14 @@ fn same_seed_same_image_whatever_the_thread_count() {
         "guided, 1 and 3 threads give different images"
     );
     assert_ne!(bits(&one), bits(&guided_one), "guiding changes nothing");
+    // Every light sample in the room ends at the pane, so next-event roulette (on by
+    // default) takes part in the renders above: it leaves out shadow rays.
+    let rays = |settings: &RenderSettings| renderer.render(&camera, settings, &|| {}).1.rays;
+    let every_light_sample = RenderSettings {
+        next_event_roulette: false,
+        ..settings.clone()
+    };
+    assert!(rays(&settings) < rays(&every_light_sample) * 3 / 4);
     assert!(one.mean().max_element() > 0.0);
     let other = render(
         2,

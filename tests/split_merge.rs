@@ -160,6 +160,46 @@ fn guided_parts_merge_to_the_guided_whole() {
     assert!(relative_difference(&unguided, &whole) > 1000.0 * MERGE_TOLERANCE);
 }
 
+/// Every process of a split render traces the same pre-pass, whatever its range, so parts
+/// rendered with next-event roulette merge to the whole.
+#[test]
+fn parts_with_next_event_roulette_merge_to_the_whole() {
+    // In the room lit through a window every light sample ends at the pane: the roulette
+    // takes part there.
+    let scene = load_scene(std::path::Path::new("tests/data/scenes/window_room.glb"))
+        .unwrap()
+        .scene;
+    let camera = scene.cameras[0].clone();
+    let renderer = Renderer::new(&scene);
+    let settings = |range: Range<u32>, next_event_roulette: bool| RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        samples: range,
+        max_depth: 8,
+        seed: 3,
+        next_event_roulette,
+        ..RenderSettings::default()
+    };
+    let (whole, stats) = renderer.render(&camera, &settings(0..SPP, true), &|| {});
+    let dir = tempfile::tempdir().unwrap();
+    let mut paths = Vec::new();
+    for range in [0..3, 3..10, 10..SPP] {
+        let part = renderer
+            .render(&camera, &settings(range.clone(), true), &|| {})
+            .0;
+        paths.push(write_rendered_part(dir.path(), &part, range, 3));
+    }
+    let (merged, _) = merge_files(&paths, Some(0..SPP)).unwrap();
+    let difference = relative_difference(&merged, &whole);
+    assert!(
+        difference <= MERGE_TOLERANCE,
+        "{difference:e} > {MERGE_TOLERANCE:e}"
+    );
+    // The roulette took part: it left out shadow rays.
+    let every_light_sample = renderer.render(&camera, &settings(0..SPP, false), &|| {}).1;
+    assert!(stats.rays < every_light_sample.rays * 3 / 4);
+}
+
 /// Writes the rendered samples `range` (seed `seed`) as a part in `dir` and returns its
 /// path.
 fn write_rendered_part(dir: &Path, part: &Image, range: Range<u32>, seed: u64) -> PathBuf {

@@ -50,6 +50,16 @@ pub enum GuidingChoice {
     Off,
 }
 
+/// A feature that is on unless turned off (`--next-event-roulette`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum Switch {
+    /// The feature is used.
+    #[default]
+    On,
+    /// The feature is not used.
+    Off,
+}
+
 /// `--progress`: how progress is reported for programs (the Blender add-on).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ProgressChoice {

@@ -45,12 +45,17 @@ pub fn render_identity(
         seed: settings.seed,
         max_depth: settings.max_depth,
         options: format!(
-            "{}{} {} {}{}",
+            "{}{} {} {}{}{}",
             load_label(inputs.load),
             shutter_label(inputs.shutter),
             environment_label(inputs.environment),
             filter_label(settings.filter, settings.filter_width),
-            guiding_label(settings.guiding)
+            guiding_label(settings.guiding),
+            if settings.next_event_roulette {
+                ""
+            } else {
+                " next-event-roulette=off"
+            }
         ),
         exposure: inputs.exposure,
         aovs: settings.aovs.label(),

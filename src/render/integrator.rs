@@ -5,11 +5,12 @@
 //! from; a scattered direction that the shading normal allows but the geometric normal
 //! does not (a light leak) ends the path.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::Renderer;
 use super::aov::Features;
 use super::guiding::{Guide, GuidedBsdf, Record};
+use super::next_event::{NextEventOdds, Outcome};
 use super::sampler::Sampler;
 use super::sampling::power_heuristic;
 use super::shading::Shading;
@@ -33,6 +34,9 @@ pub enum Strategy {
 /// Shadow segments end this fraction short of the light point.
 const SHADOW_EPSILON: f32 = 1e-4;
 
+/// The largest f32 below 1: a number rescaled into [0, 1) stays below 1.
+const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
 /// Path depth at which Russian roulette starts.
 const ROULETTE_DEPTH: u32 = 3;
 
@@ -44,8 +48,9 @@ const MAX_PASS_THROUGHS: u32 = 256;
 enum Arrival {
     /// From the camera or through a delta lobe: emission is counted in full.
     Specular,
-    /// From a non-delta BSDF sample with this solid-angle pdf.
-    Scattered { pdf: f32 },
+    /// From a non-delta BSDF sample with this solid-angle pdf, at a vertex that took its
+    /// next-event estimate with these odds.
+    Scattered { pdf: f32, light_odds: f32 },
 }
 
 /// Whether a path draws directions from a guide, and whether it teaches one.
@@ -81,13 +86,53 @@ pub struct PathResult {
     pub features: Features,
 }
 
-/// What a path is asked to do: its most scattering events, its direct-light estimator and
-/// its guide.
+/// Whether a path takes every next-event estimate, and whether it records what they found.
 #[derive(Clone, Copy)]
-struct Asked<'a> {
-    max_depth: u32,
-    strategy: Strategy,
-    guiding: PathGuiding<'a>,
+pub enum NextEvent<'a> {
+    /// At every vertex whose BSDF is not a delta.
+    Always,
+    /// As [`NextEvent::Always`], recording each light sample's [`Outcome`].
+    Learn,
+    /// With the odds learned at the vertex ([`super::next_event`]).
+    Roulette(&'a NextEventOdds),
+}
+
+impl NextEvent<'_> {
+    fn odds_at(self, p: Vec3) -> f32 {
+        match self {
+            NextEvent::Always | NextEvent::Learn => 1.0,
+            NextEvent::Roulette(odds) => odds.at(p),
+        }
+    }
+}
+
+/// What a path is asked to do.
+#[derive(Clone, Copy)]
+pub struct PathOptions<'a> {
+    /// Most scattering events.
+    pub max_depth: u32,
+    /// The direct-light estimator.
+    pub strategy: Strategy,
+    /// Report the path's [`Features`] (which changes no random number, so not the
+    /// radiance).
+    pub want_features: bool,
+    /// The guide, if any.
+    pub guiding: PathGuiding<'a>,
+    /// How next-event estimates are taken.
+    pub next_event: NextEvent<'a>,
+}
+
+impl PathOptions<'_> {
+    /// Every next-event estimate, no guide, no features.
+    pub fn plain(max_depth: u32, strategy: Strategy) -> PathOptions<'static> {
+        PathOptions {
+            max_depth,
+            strategy,
+            want_features: false,
+            guiding: PathGuiding::Off,
+            next_event: NextEvent::Always,
+        }
+    }
 }
 
 /// A scattering vertex, as the bounce from it needs it.
@@ -130,6 +175,8 @@ struct Path {
     result: PathResult,
     /// Guided vertices of a training path, completed when it ends.
     records: Vec<Record>,
+    /// What its light samples found, when asked to learn.
+    outcomes: Vec<Outcome>,
 }
 
 impl Path {
@@ -148,6 +195,7 @@ impl Path {
             seeking: want_features,
             result: PathResult::default(),
             records: Vec::new(),
+            outcomes: Vec::new(),
         }
     }
 
@@ -211,6 +259,7 @@ impl Path {
         scatter: &GuidedBsdf,
         sampler: &mut Sampler,
         guiding: PathGuiding,
+        light_odds: f32,
     ) -> bool {
         let s = vertex.surface;
         let Some((sample, (guide_pdf, bsdf_pdf))) =
@@ -240,7 +289,10 @@ impl Path {
         self.arrival = if sample.is_delta {
             Arrival::Specular
         } else {
-            Arrival::Scattered { pdf: sample.pdf }
+            Arrival::Scattered {
+                pdf: sample.pdf,
+                light_odds,
+            }
         };
         self.ray = Ray::new(
             offset_ray_origin(s.point, s.point_error, vertex.ng, sample.wi),
@@ -281,46 +333,40 @@ impl Renderer<'_> {
         max_depth: u32,
         strategy: Strategy,
     ) -> PathResult {
-        self.trace_path_with_features(ray, sampler, max_depth, strategy, false)
+        self.trace_path_with(ray, sampler, PathOptions::plain(max_depth, strategy))
     }
 
-    /// [`Renderer::trace_path`], also reporting the path's [`Features`] when
-    /// `want_features` (which changes no random number, so not the radiance).
-    pub fn trace_path_with_features(
+    /// [`Renderer::trace_path`] as `options` ask: with features, drawing directions at
+    /// diffuse vertices also from a guide ([`super::guiding`]), with next-event roulette
+    /// ([`super::next_event`]).
+    pub fn trace_path_with(
+        &self,
+        ray: Ray,
+        sampler: &mut Sampler,
+        options: PathOptions,
+    ) -> PathResult {
+        self.trace(ray, sampler, options).result
+    }
+
+    /// The outcomes of the light samples of one path that takes every estimate.
+    pub(crate) fn light_sample_outcomes(
         &self,
         ray: Ray,
         sampler: &mut Sampler,
         max_depth: u32,
         strategy: Strategy,
-        want_features: bool,
-    ) -> PathResult {
-        self.trace_path_guided(
-            ray,
-            sampler,
-            max_depth,
-            strategy,
-            want_features,
-            PathGuiding::Off,
-        )
-    }
-
-    /// [`Renderer::trace_path_with_features`], drawing directions at diffuse vertices also
-    /// from a guide when `guiding` has one ([`super::guiding`]).
-    pub fn trace_path_guided(
-        &self,
-        ray: Ray,
-        sampler: &mut Sampler,
-        max_depth: u32,
-        strategy: Strategy,
-        want_features: bool,
-        guiding: PathGuiding,
-    ) -> PathResult {
-        let asked = Asked {
-            max_depth,
-            strategy,
-            guiding,
+    ) -> Vec<Outcome> {
+        let options = PathOptions {
+            next_event: NextEvent::Learn,
+            ..PathOptions::plain(max_depth, strategy)
         };
-        let mut path = Path::new(ray, want_features);
+        self.trace(ray, sampler, options).outcomes
+    }
+
+    /// Follows one path from `ray` to its end.
+    fn trace(&self, ray: Ray, sampler: &mut Sampler, options: PathOptions) -> Path {
+        let strategy = options.strategy;
+        let mut path = Path::new(ray, options.want_features);
         loop {
             path.result.rays += 1;
             let hit = self.accel.intersect(&path.ray);
@@ -348,14 +394,14 @@ impl Renderer<'_> {
                 }
                 continue;
             }
-            if !self.scatter_at(&mut path, &hit, &s, sampler, asked) {
+            if !self.scatter_at(&mut path, &hit, &s, sampler, options) {
                 break;
             }
         }
-        if let PathGuiding::Train(guide) = guiding {
+        if let PathGuiding::Train(guide) = options.guiding {
             guide.add_path(&path.records, path.result.radiance);
         }
-        path.result
+        path
     }
 
     /// Sphere lamps the path's segment passes before its hit (`None`: the segment leaves
@@ -413,7 +459,7 @@ impl Renderer<'_> {
         hit: &SceneHit,
         s: &Surface,
         sampler: &mut Sampler,
-        asked: Asked,
+        options: PathOptions,
     ) -> bool {
         let material = &self.scene.materials[s.material];
         path.result.hit |= path.depth == 0;
@@ -432,14 +478,14 @@ impl Renderer<'_> {
         // Emission reached by the previous bounce.
         if material.is_emissive() && (front || material.double_sided) {
             let weight =
-                self.emission_weight_at(hit, path.from(), cos_o, path.arrival, asked.strategy);
+                self.emission_weight_at(hit, path.from(), cos_o, path.arrival, options.strategy);
             path.result.radiance += weight * path.beta * shading.emission;
         }
         // A one-sided surface's back is black, but for glass it is the inside of the
         // volume. Whether this point is glass is read from the material as textured here
         // (a glTF metallic texture can make a metal factor 0), not from its factors.
         let two_sided = material.double_sided || shading.bsdf.transmits();
-        if path.depth == asked.max_depth || (!front && !two_sided) {
+        if path.depth == options.max_depth || (!front && !two_sided) {
             return false;
         }
 
@@ -449,12 +495,12 @@ impl Renderer<'_> {
             -s.geometric_normal
         };
         let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo);
-        let (guide, fraction) = match asked.guiding.guide() {
+        let (guide, fraction) = match options.guiding.guide() {
             Some(g) if bsdf.is_guidable() => {
                 let (distribution, fraction) = g.at(s.point);
                 // A region whose share is 0 samples the BSDF alone, but goes on recording
                 // while training, to score the shares again.
-                let training = matches!(asked.guiding, PathGuiding::Train(_));
+                let training = matches!(options.guiding, PathGuiding::Train(_));
                 (
                     (fraction > 0.0 || training).then_some(distribution),
                     fraction,
@@ -470,12 +516,38 @@ impl Renderer<'_> {
 
         // Sample a light for the next-event estimate. Punctual lights can only be found
         // this way, so even the BSDF-only estimator samples them.
-        if !bsdf.is_delta()
-            && (asked.strategy != Strategy::BsdfOnly || self.lights.punctual_len() > 0)
-        {
+        let takes_light = !bsdf.is_delta()
+            && (options.strategy != Strategy::BsdfOnly || self.lights.punctual_len() > 0);
+        let light_odds = if takes_light {
+            options.next_event.odds_at(s.point)
+        } else {
+            1.0
+        };
+        // The light choice's number also decides the roulette, so that every sample of a
+        // pixel draws the same sets in the same order, keeping them stratified.
+        let (u_light, u) = if takes_light {
+            (sampler.uniform(), sampler.uniform2())
+        } else {
+            (1.0, Vec2::ZERO)
+        };
+        if takes_light && u_light < light_odds {
             path.result.rays += 1;
-            path.result.radiance +=
-                path.beta * self.direct_light(&scatter, s, ng, ns, wo, sampler, asked.strategy);
+            let numbers = ((u_light / light_odds).min(ONE_MINUS_EPSILON), u);
+            let light = self.direct_light(
+                &scatter,
+                s,
+                (ng, ns, wo),
+                (light_odds, numbers),
+                sampler,
+                options.strategy,
+            );
+            if let NextEvent::Learn = options.next_event {
+                path.outcomes.push(Outcome {
+                    point: s.point,
+                    reached: light != Vec3::ZERO,
+                });
+            }
+            path.result.radiance += path.beta * light / light_odds;
         }
         let vertex = Vertex {
             surface: s,
@@ -485,26 +557,25 @@ impl Renderer<'_> {
             entering: front && material.absorption != Vec3::ZERO,
             absorption: material.absorption,
         };
-        path.extend(&vertex, &scatter, sampler, asked.guiding)
+        path.extend(&vertex, &scatter, sampler, options.guiding, light_odds)
     }
 
-    /// One light-sampling estimate of reflected direct light, MIS-weighted when asked.
+    /// One light-sampling estimate of reflected direct light at `s` (its oriented geometric
+    /// and shading normals and the direction out), MIS-weighted when asked, as if light
+    /// samples were taken with `light_odds` (the caller divides by them), from the numbers
+    /// `(u_light, u)` for the light's choice and the point on it.
     ///
     /// Delta lights are sampled even by the BSDF-only estimator, since nothing else finds
     /// them; it samples nothing else.
-    #[allow(clippy::too_many_arguments)]
     fn direct_light(
         &self,
         bsdf: &GuidedBsdf,
         s: &Surface,
-        ng: Vec3,
-        ns: Vec3,
-        wo: Vec3,
+        (ng, ns, wo): (Vec3, Vec3, Vec3),
+        (light_odds, (u_light, u)): (f32, (f32, Vec2)),
         sampler: &mut Sampler,
         strategy: Strategy,
     ) -> Vec3 {
-        let u_light = sampler.uniform();
-        let u = sampler.uniform2();
         let sample = if strategy == Strategy::BsdfOnly {
             self.lights.sample_punctual(s.point, u_light)
         } else {
@@ -538,7 +609,9 @@ impl Renderer<'_> {
             return Vec3::ZERO;
         }
         let weight = match strategy {
-            Strategy::Mis if !ls.is_delta => power_heuristic(ls.pdf, bsdf.pdf(ns, wo, ls.wi)),
+            Strategy::Mis if !ls.is_delta => {
+                power_heuristic(light_odds * ls.pdf, bsdf.pdf(ns, wo, ls.wi))
+            }
             _ => 1.0,
         };
         f * ls.radiance * (weight / ls.pdf)
@@ -594,13 +667,16 @@ impl Renderer<'_> {
 }
 
 /// The weight of emission found by a ray that arrived as `arrival`, from a light that
-/// light sampling would have drawn with solid-angle density `light_pdf()`: full after the
-/// camera or a delta lobe, and otherwise as the strategy says (the power heuristic for MIS).
-/// The density, a walk of the light tree, is worked out only for MIS.
+/// light sampling would have drawn with solid-angle density `light_pdf()` (times the odds
+/// of the estimate at the vertex left): full after the camera or a delta lobe, and
+/// otherwise as the strategy says (the power heuristic for MIS). The density, a walk of
+/// the light tree, is worked out only for MIS.
 fn emission_weight(arrival: Arrival, strategy: Strategy, light_pdf: impl FnOnce() -> f32) -> f32 {
     match (arrival, strategy) {
         (Arrival::Specular, _) | (_, Strategy::BsdfOnly) => 1.0,
         (Arrival::Scattered { .. }, Strategy::LightOnly) => 0.0,
-        (Arrival::Scattered { pdf }, Strategy::Mis) => power_heuristic(pdf, light_pdf()),
+        (Arrival::Scattered { pdf, light_odds }, Strategy::Mis) => {
+            power_heuristic(pdf, light_odds * light_pdf())
+        }
     }
 }

@@ -15,6 +15,7 @@ mod filter;
 mod guiding;
 mod integrator;
 mod lights;
+mod next_event;
 pub mod sampler;
 pub mod sampling;
 mod shading;
@@ -27,8 +28,9 @@ pub use coverage::{ViewCoverage, view_coverage};
 pub use film::{Film, Image, PixelAccumulator};
 pub use filter::{FilterKind, PixelFilter, profile as filter_profile};
 pub use guiding::Guiding;
-pub use integrator::{PathResult, Strategy};
+pub use integrator::{NextEvent, PathGuiding, PathOptions, PathResult, Strategy};
 pub use lights::{EmissiveTriangles, LightSample, LightSet};
+pub use next_event::{NextEventOdds, Outcome};
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -79,6 +81,9 @@ pub struct RenderSettings {
     pub time_limit: Option<Duration>,
     /// Path guiding: trained on the first samples when on ([`guiding`]).
     pub guiding: Guiding,
+    /// Next-event roulette: light samples are taken rarely where a pre-pass found they
+    /// never reach their light ([`next_event`]).
+    pub next_event_roulette: bool,
 }
 
 impl Default for RenderSettings {
@@ -96,6 +101,7 @@ impl Default for RenderSettings {
             noise_threshold: None,
             time_limit: None,
             guiding: Guiding::Off,
+            next_event_roulette: true,
         }
     }
 }
@@ -150,7 +156,7 @@ impl CameraSampling {
     /// The camera ray of the sample `sampler` stands at, through pixel (`x`, `y`). It draws
     /// the filter offset, then a lens position only when there is a lens and a shutter
     /// time only when something moves, so that other images keep their random streams.
-    fn ray(&self, x: usize, y: usize, sampler: &mut Sampler) -> Ray {
+    pub(crate) fn ray(&self, x: usize, y: usize, sampler: &mut Sampler) -> Ray {
         let at = self.filter.sample(sampler.uniform2());
         let lens = if self.generator.has_lens() {
             sampler.uniform2()
@@ -264,9 +270,14 @@ impl<'a> Renderer<'a> {
         let adaptive = settings
             .noise_threshold
             .map(|t| adaptive::Schedule::new(t, spp));
+        let odds = settings
+            .next_event_roulette
+            .then(|| self.learn_next_event_odds(&view, settings))
+            .filter(|odds| odds.lowers_any());
+        let next_event = odds.as_ref().map_or(NextEvent::Always, NextEvent::Roulette);
         let mut guide = (settings.guiding == Guiding::On).then(|| {
             let mut guide = Guide::new(self.scene.bounds());
-            self.train_guide_before(&view, settings, &mut guide, first_sample);
+            self.train_guide_before(&view, settings, &mut guide, first_sample, next_event);
             guide
         });
         let mut film = Film::new(
@@ -300,14 +311,14 @@ impl<'a> Renderer<'a> {
                         let pixel = (row.y * width + x) as u64;
                         let mut sampler = Sampler::for_sample(seed, pixel, sample);
                         let ray = view.ray(x, row.y, &mut sampler);
-                        let path = self.trace_path_guided(
-                            ray,
-                            &mut sampler,
-                            settings.max_depth,
-                            settings.strategy,
-                            wants_features,
+                        let options = PathOptions {
+                            max_depth: settings.max_depth,
+                            strategy: settings.strategy,
+                            want_features: wants_features,
                             guiding,
-                        );
+                            next_event,
+                        };
+                        let path = self.trace_path_with(ray, &mut sampler, options);
                         rays += path.rays;
                         samples += 1;
                         row.add(x, path.radiance, path.hit, &path.features);

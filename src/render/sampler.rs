@@ -16,8 +16,10 @@
 //!
 //! A path asks for its sets in this order: pixel filter (pair), lens (pair, when there is
 //! one), shutter time (one, when something moves), then per vertex: alpha tests (one
-//! each, when a surface is blended), light choice (one) and point on it (pair), BSDF lobe
-//! (one) and direction (pair), Russian roulette (one).
+//! each, when a surface is blended), light choice (one, which also decides next-event
+//! roulette) and point on it (pair), BSDF lobe (one) and direction (pair), Russian
+//! roulette (one). A vertex draws the light's sets whether or not the roulette takes its
+//! light sample, so that later sets stay stratified over the pixel's samples.
 
 use glam::Vec2;
 

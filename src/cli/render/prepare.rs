@@ -7,7 +7,7 @@ use anyhow::{Context, Result, anyhow, bail};
 
 use super::super::args::Args;
 use super::super::camera::{CameraPick, camera_label, image_size, with_depth_of_field};
-use super::super::choices::GuidingChoice;
+use super::super::choices::{GuidingChoice, Switch};
 use super::super::environment::{
     EnvironmentSetting, EnvironmentSource, OBJECT_ON_NOTHING, apply_environment, studio_note,
 };
@@ -208,6 +208,7 @@ fn frame(
         noise_threshold: sampling.noise_threshold,
         time_limit: sampling.time_limit.map(Duration::from_secs_f64),
         guiding: guiding_for(sampling.guiding),
+        next_event_roulette: sampling.next_event_roulette == Switch::On,
     };
     Ok((camera, settings))
 }

@@ -11,7 +11,7 @@
 use rayon::prelude::*;
 
 use super::Guide;
-use crate::render::integrator::PathGuiding;
+use crate::render::integrator::{NextEvent, PathGuiding, PathOptions};
 use crate::render::sampler::Sampler;
 use crate::render::{CameraSampling, RenderSettings, Renderer};
 
@@ -55,6 +55,7 @@ impl Renderer<'_> {
         settings: &RenderSettings,
         guide: &mut Guide,
         end: u32,
+        next_event: NextEvent,
     ) {
         let seed = crate::render::sampling::mix64(settings.seed);
         let (width, height) = (settings.width as usize, settings.height as usize);
@@ -63,14 +64,14 @@ impl Renderer<'_> {
                 for x in 0..width {
                     let mut sampler = Sampler::for_sample(seed, (y * width + x) as u64, sample);
                     let ray = view.ray(x, y, &mut sampler);
-                    self.trace_path_guided(
-                        ray,
-                        &mut sampler,
-                        settings.max_depth,
-                        settings.strategy,
-                        false,
-                        PathGuiding::Train(guide),
-                    );
+                    let options = PathOptions {
+                        max_depth: settings.max_depth,
+                        strategy: settings.strategy,
+                        want_features: false,
+                        guiding: PathGuiding::Train(guide),
+                        next_event,
+                    };
+                    self.trace_path_with(ray, &mut sampler, options);
                 }
             });
             guide.after_sample(sample);

@@ -4,19 +4,25 @@
 use glam::DVec3;
 use gridtrace::accel::Ray;
 use gridtrace::render::sampler::Sampler;
-use gridtrace::render::{Renderer, Strategy};
+use gridtrace::render::{PathOptions, Renderer, Strategy};
 use gridtrace::scene::Scene;
 
 /// Mean radiance along `ray` over `n` paths (the samples of one pixel) and its standard
 /// error, per channel.
 pub fn estimate(scene: &Scene, ray: Ray, strategy: Strategy, n: u32) -> (DVec3, DVec3) {
+    estimate_with(scene, ray, PathOptions::plain(64, strategy), n)
+}
+
+/// [`estimate`] with paths traced as `options` ask.
+#[allow(dead_code)]
+pub fn estimate_with(scene: &Scene, ray: Ray, options: PathOptions, n: u32) -> (DVec3, DVec3) {
     let renderer = Renderer::new(scene);
     let (mut sum, mut sum2) = (DVec3::ZERO, DVec3::ZERO);
     for i in 0..n {
         // The samples of one pixel: stratified, so the spread of the paths over-states the
         // error of their mean, never under-states it.
         let l = renderer
-            .trace_path(ray, &mut Sampler::for_sample(7, 11, i), 64, strategy)
+            .trace_path_with(ray, &mut Sampler::for_sample(7, 11, i), options)
             .radiance
             .as_dvec3();
         sum += l;
