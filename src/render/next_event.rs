@@ -99,7 +99,9 @@ impl Renderer<'_> {
     }
 }
 
-/// A node of the tree: inner nodes split space at `at` along `axis`.
+/// A node of the tree: inner nodes split space at `at` along `axis`; a subtree whose
+/// regions all keep odds 1 is one node, so that lit parts of a scene are found in few
+/// steps.
 #[derive(Clone, Copy, Debug)]
 enum Node {
     Inner {
@@ -111,10 +113,11 @@ enum Node {
     Leaf {
         region: u32,
     },
+    Always,
 }
 
-/// A leaf: the box of its records, a little grown, and its odds. Points outside the box
-/// were not seen by the pre-pass and take the estimate always.
+/// A leaf with lowered odds: the box of its records, a little grown, and its odds. Points
+/// outside the box were not seen by the pre-pass and take the estimate always.
 #[derive(Clone, Copy, Debug)]
 struct Region {
     bounds: Aabb,
@@ -141,7 +144,7 @@ impl NextEventOdds {
 
     /// True when some region's odds are below 1 (else the odds change nothing).
     pub fn lowers_any(&self) -> bool {
-        self.regions.iter().any(|r| r.odds < 1.0)
+        !self.regions.is_empty()
     }
 
     /// The odds of taking the next-event estimate at `p`.
@@ -165,6 +168,7 @@ impl NextEventOdds {
                     let inside = p.cmpge(r.bounds.min).all() && p.cmple(r.bounds.max).all();
                     return if inside { r.odds } else { 1.0 };
                 }
+                Node::Always => return 1.0,
             }
         }
     }
@@ -176,10 +180,15 @@ impl NextEventOdds {
         let extent = bounds.max - bounds.min;
         let axis = extent.max_position();
         if outcomes.len() <= MAX_LEAF_RECORDS || depth == MAX_DEPTH || extent[axis] <= 0.0 {
-            self.nodes.push(Node::Leaf {
-                region: self.regions.len() as u32,
-            });
-            self.regions.push(region_of(outcomes, bounds));
+            match region_of(outcomes, bounds) {
+                Some(region) => {
+                    self.nodes.push(Node::Leaf {
+                        region: self.regions.len() as u32,
+                    });
+                    self.regions.push(region);
+                }
+                None => self.nodes.push(Node::Always),
+            }
             return index;
         }
         let middle = outcomes.len() / 2;
@@ -191,6 +200,13 @@ impl NextEventOdds {
         self.nodes.push(Node::Leaf { region: 0 });
         let below = self.build(below, depth + 1);
         let above = self.build(above, depth + 1);
+        if let (Node::Always, Node::Always) =
+            (self.nodes[below as usize], self.nodes[above as usize])
+        {
+            self.nodes.truncate(index as usize);
+            self.nodes.push(Node::Always);
+            return index;
+        }
         self.nodes[index as usize] = Node::Inner {
             axis: axis as u8,
             at,
@@ -201,17 +217,17 @@ impl NextEventOdds {
     }
 }
 
-/// A leaf's region: its odds are lowered only when many records all failed.
-fn region_of(outcomes: &[Outcome], bounds: Aabb) -> Region {
+/// A leaf's region with lowered odds, when many records all failed (else none: odds 1).
+fn region_of(outcomes: &[Outcome], bounds: Aabb) -> Option<Region> {
     let unseen = outcomes.len() >= MIN_RECORDS && !outcomes.iter().any(|o| o.reached);
     let grow = (bounds.max - bounds.min) * 0.05 + Vec3::splat(1e-4);
-    Region {
+    unseen.then_some(Region {
         bounds: Aabb {
             min: bounds.min - grow,
             max: bounds.max + grow,
         },
-        odds: if unseen { UNSEEN_ODDS } else { 1.0 },
-    }
+        odds: UNSEEN_ODDS,
+    })
 }
 
 #[cfg(test)]
@@ -253,6 +269,14 @@ mod tests {
     }
 
     #[test]
+    fn a_lit_scene_is_one_node() {
+        let odds = NextEventOdds::learn(grid_outcomes(|p| p.x < 3.9));
+        assert_eq!(odds.nodes.len(), 1);
+        assert!(!odds.lowers_any());
+        assert_eq!(odds.at(Vec3::new(3.95, 1.0, 0.0)), 1.0);
+    }
+
+    #[test]
     fn few_records_keep_the_estimate() {
         let outcomes = grid_outcomes(|_| false)
             .into_iter()
@@ -271,7 +295,7 @@ mod tests {
             10_000
         ];
         let odds = NextEventOdds::learn(outcomes);
-        assert_eq!(odds.regions.len(), 1);
+        assert_eq!((odds.nodes.len(), odds.regions.len()), (1, 1));
         assert_eq!(odds.at(Vec3::ONE), UNSEEN_ODDS);
     }
 
