@@ -2,6 +2,8 @@
 //! resolved into a BSDF, an emitted radiance and a shading normal; and the alpha that decides
 //! whether the surface is there at all.
 
+use std::borrow::Cow;
+
 use glam::{Vec2, Vec3, Vec4};
 
 use super::Renderer;
@@ -11,10 +13,12 @@ use super::surface::Surface;
 use crate::scene::{AlphaMode, ChannelRef, ColorSpace, Material, Mesh, Pbr, Scene, TextureRef};
 
 /// A material evaluated at a point.
-#[derive(Clone, Copy, Debug)]
-pub struct Shading {
-    /// The scattering model with its colour.
-    pub bsdf: Bsdf,
+#[derive(Clone, Debug)]
+pub struct Shading<'a> {
+    /// The scattering model with its colour: the material's own, borrowed, unless textures
+    /// vary it (a BSDF is a few hundred bytes, and copying it at every vertex showed in
+    /// profiles).
+    pub bsdf: Cow<'a, Bsdf>,
     /// Emitted radiance.
     pub emission: Vec3,
     /// The base colour with its texture and vertex colour (what an unlit surface shows).
@@ -30,22 +34,29 @@ pub struct Shading {
     pub anisotropy_direction: Option<Vec3>,
 }
 
-impl Shading {
+impl Shading<'_> {
     /// The BSDF turned to the side of `ng` (the geometric normal on the side `wo` lies
     /// on), and the normal its glossy lobes turn about: the shading normal raised until
     /// mirror reflection stays above the surface, as Cycles does
     /// ([`valid_reflection_normal`]), while the diffuse base and sheen keep the shading
     /// normal and, where a normal map bent it away from the interpolated `smooth` normal,
     /// take the bump shadowing.
-    pub fn oriented(&self, smooth: Vec3, ng: Vec3, wo: Vec3) -> (Bsdf, Vec3) {
+    pub fn oriented(&self, smooth: Vec3, ng: Vec3, wo: Vec3) -> (Cow<'_, Bsdf>, Vec3) {
         let side = if self.normal.dot(ng) < 0.0 { -1.0 } else { 1.0 };
         let diffuse = side * self.normal;
         let n = valid_reflection_normal(ng, wo, diffuse);
+        let unchanged = self.coat_normal.is_none()
+            && n == diffuse
+            && self.normal == smooth
+            && self.anisotropy_direction.is_none();
+        if unchanged {
+            return (Cow::Borrowed(&*self.bsdf), n);
+        }
         let mut bsdf = match self.coat_normal {
             Some(coat) => self
                 .bsdf
                 .with_coat_normal(n, valid_reflection_normal(ng, wo, side * coat)),
-            None => self.bsdf,
+            None => *self.bsdf,
         };
         if n != diffuse {
             bsdf = bsdf.with_diffuse_normal(n, diffuse);
@@ -56,7 +67,7 @@ impl Shading {
         if let Some(direction) = self.anisotropy_direction {
             bsdf = bsdf.with_tangent(n, direction);
         }
-        (bsdf, n)
+        (Cow::Owned(bsdf), n)
     }
 }
 
@@ -82,11 +93,11 @@ pub fn texture_at(
 
 impl Renderer<'_> {
     /// The material of `s` evaluated there, for a ray arriving on the `front` side.
-    pub(super) fn shade(&self, s: &Surface, front: bool) -> Shading {
+    pub(super) fn shade(&self, s: &Surface, front: bool) -> Shading<'_> {
         let material = &self.scene.materials[s.material];
         if !material.varies() {
             return Shading {
-                bsdf: self.bsdfs[s.material][usize::from(!front)],
+                bsdf: Cow::Borrowed(&self.bsdfs[s.material][usize::from(!front)]),
                 emission: material.emission,
                 base_colour: material.pbr.base_colour,
                 normal: s.shading_normal,
@@ -140,7 +151,7 @@ impl Renderer<'_> {
             .then(|| self.anisotropy_direction(s, mesh, &mut pbr, lookup))
             .flatten();
         Shading {
-            bsdf: Bsdf::new(&pbr, front),
+            bsdf: Cow::Owned(Bsdf::new(&pbr, front)),
             emission,
             base_colour: pbr.base_colour,
             normal,
