@@ -11,8 +11,8 @@
 //! sampling density, so emission found by BSDF sampling takes over where light samples
 //! are rare.
 //!
-//! The pre-pass traces one path through every [`STRIDE`]-th pixel of every
-//! [`STRIDE`]-th row, from a random stream of its own, whatever range of samples the
+//! The pre-pass traces one path through every [`stride`]-th pixel of every
+//! [`stride`]-th row, from a random stream of its own, whatever range of samples the
 //! render takes; records are gathered in pixel order and the regions cut from them by
 //! medians, so every process of a split render, on any number of threads, holds the same
 //! odds, and split renders still merge exactly.
@@ -33,7 +33,8 @@ const PRE_PASS_SEED: u64 = 0x6e65_7874_2d65_7665;
 pub const UNSEEN_ODDS: f32 = 1.0 / 16.0;
 
 /// A region needs this many records before its odds are lowered: with no success among
-/// 64 tries, the chance of success is below 5 % with 95 % confidence.
+/// 256 tries, the chance of success is below 1.2 % with 95 % confidence (so a penumbra,
+/// where light arrives a few times in a hundred, keeps its light samples).
 const MIN_RECORDS: usize = 256;
 
 /// Regions are halved until they hold at most this many records.
