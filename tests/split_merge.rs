@@ -17,7 +17,7 @@ use gridtrace::output::merge::{MERGE_TOLERANCE, MergeError, merge_files, read_pa
 use gridtrace::output::{ViewTransform, write_image, write_image_with_record};
 use gridtrace::record::{RenderIdentity, RenderRecord};
 use gridtrace::render::{Guiding, Image, RenderSettings, Renderer};
-use gridtrace::scene::Camera;
+use gridtrace::scene::{Camera, Scene};
 
 const SIZE: u32 = 32;
 const SPP: u32 = 16;
@@ -137,24 +137,14 @@ fn merged_parts_equal_one_render_for_one_two_and_four_parts() {
 fn guided_parts_merge_to_the_guided_whole() {
     // The room lit through a window: guiding takes part there (in a Cornell box, every
     // region may keep the BSDF alone).
-    let scene = load_scene(std::path::Path::new("tests/data/scenes/window_room.glb"))
-        .unwrap()
-        .scene;
+    let scene = window_room();
     let camera = scene.cameras[0].clone();
     let renderer = Renderer::new(&scene);
     let whole = render_guided(&renderer, &camera, 0..SPP, 3, Guiding::On);
-    let dir = tempfile::tempdir().unwrap();
-    let mut paths = Vec::new();
-    for range in [0..5, 5..SPP] {
-        let part = render_guided(&renderer, &camera, range.clone(), 3, Guiding::On);
-        paths.push(write_rendered_part(dir.path(), &part, range, 3));
-    }
-    let (merged, _) = merge_files(&paths, Some(0..SPP)).unwrap();
-    let difference = relative_difference(&merged, &whole);
-    assert!(
-        difference <= MERGE_TOLERANCE,
-        "{difference:e} > {MERGE_TOLERANCE:e}"
-    );
+    let merged = merge_of_parts(&[0..5, 5..SPP], |range| {
+        render_guided(&renderer, &camera, range, 3, Guiding::On)
+    });
+    assert_within_merge_tolerance(&merged, &whole);
     // Guiding changed the samples: the comparison is of guided renders.
     let unguided = render(&renderer, &camera, 0..SPP, 3);
     assert!(relative_difference(&unguided, &whole) > 1000.0 * MERGE_TOLERANCE);
@@ -166,9 +156,7 @@ fn guided_parts_merge_to_the_guided_whole() {
 fn parts_with_next_event_roulette_merge_to_the_whole() {
     // In the room lit through a window every light sample ends at the pane: the roulette
     // takes part there.
-    let scene = load_scene(std::path::Path::new("tests/data/scenes/window_room.glb"))
-        .unwrap()
-        .scene;
+    let scene = window_room();
     let camera = scene.cameras[0].clone();
     let renderer = Renderer::new(&scene);
     let settings = |range: Range<u32>, next_event_roulette: bool| RenderSettings {
@@ -181,23 +169,41 @@ fn parts_with_next_event_roulette_merge_to_the_whole() {
         ..RenderSettings::default()
     };
     let (whole, stats) = renderer.render(&camera, &settings(0..SPP, true), &|| {});
+    let merged = merge_of_parts(&[0..3, 3..10, 10..SPP], |range| {
+        renderer.render(&camera, &settings(range, true), &|| {}).0
+    });
+    assert_within_merge_tolerance(&merged, &whole);
+    // The roulette took part: it left out shadow rays.
+    let every_light_sample = renderer.render(&camera, &settings(0..SPP, false), &|| {}).1;
+    assert!(stats.rays < every_light_sample.rays * 3 / 4);
+}
+
+/// The room lit only through a glazed window, where guiding and next-event roulette both
+/// take part.
+fn window_room() -> Scene {
+    load_scene(Path::new("tests/data/scenes/window_room.glb"))
+        .unwrap()
+        .scene
+}
+
+/// Renders each of `ranges` (seed 3) with `render`, writes them as parts and merges them
+/// into samples 0..SPP.
+fn merge_of_parts(ranges: &[Range<u32>], render: impl Fn(Range<u32>) -> Image) -> Image {
     let dir = tempfile::tempdir().unwrap();
-    let mut paths = Vec::new();
-    for range in [0..3, 3..10, 10..SPP] {
-        let part = renderer
-            .render(&camera, &settings(range.clone(), true), &|| {})
-            .0;
-        paths.push(write_rendered_part(dir.path(), &part, range, 3));
-    }
-    let (merged, _) = merge_files(&paths, Some(0..SPP)).unwrap();
-    let difference = relative_difference(&merged, &whole);
+    let paths: Vec<PathBuf> = ranges
+        .iter()
+        .map(|range| write_rendered_part(dir.path(), &render(range.clone()), range.clone(), 3))
+        .collect();
+    merge_files(&paths, Some(0..SPP)).unwrap().0
+}
+
+/// Asserts that a merge equals the whole render to the merge's rounding bound.
+fn assert_within_merge_tolerance(merged: &Image, whole: &Image) {
+    let difference = relative_difference(merged, whole);
     assert!(
         difference <= MERGE_TOLERANCE,
         "{difference:e} > {MERGE_TOLERANCE:e}"
     );
-    // The roulette took part: it left out shadow rays.
-    let every_light_sample = renderer.render(&camera, &settings(0..SPP, false), &|| {}).1;
-    assert!(stats.rays < every_light_sample.rays * 3 / 4);
 }
 
 /// Writes the rendered samples `range` (seed `seed`) as a part in `dir` and returns its
