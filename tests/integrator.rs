@@ -420,8 +420,10 @@ fn same_seed_same_image_whatever_the_thread_count() {
     let camera = scene.cameras[0].clone();
     let renderer = Renderer::new(&scene);
     let settings = RenderSettings {
-        width: 40,
-        height: 40,
+        // Large enough that some region learns a share above 0 within the first training
+        // passes (at 40 × 40 none may: then guiding would change nothing).
+        width: 48,
+        height: 48,
         // Past the first training passes, where the guide's shares are still 0.
         samples: 0..8,
         seed: 42,

@@ -525,10 +525,10 @@ impl Renderer<'_> {
         };
         // The light choice's number also decides the roulette, so that every sample of a
         // pixel draws the same sets in the same order, keeping them stratified.
-        let (u_light, u) = if takes_light {
-            (sampler.uniform(), sampler.uniform2())
+        let (u, u_light) = if takes_light {
+            sampler.uniform3()
         } else {
-            (1.0, Vec2::ZERO)
+            (Vec2::ZERO, 1.0)
         };
         if takes_light && u_light < light_odds {
             path.result.rays += 1;

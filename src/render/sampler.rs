@@ -16,10 +16,13 @@
 //!
 //! A path asks for its sets in this order: pixel filter (pair), lens (pair, when there is
 //! one), shutter time (one, when something moves), then per vertex: alpha tests (one
-//! each, when a surface is blended), light choice (one, which also decides next-event
-//! roulette) and point on it (pair), BSDF lobe (one) and direction (pair), Russian
-//! roulette (one). A vertex draws the light's sets whether or not the roulette takes its
-//! light sample, so that later sets stay stratified over the pixel's samples.
+//! each, when a surface is blended), the light sample (a triple: the point on the light
+//! and the light's choice, which also decides next-event roulette), the BSDF sample (a
+//! triple: the direction and the lobe), Russian roulette (one). A choice and what is drawn
+//! from the part chosen share a set, so together they are stratified over the whole (two
+//! triangles of a quad light are sampled as evenly as one quad). A vertex draws the light's
+//! set whether or not the roulette takes its light sample, so that later sets stay
+//! stratified over the pixel's samples.
 
 use glam::Vec2;
 
@@ -66,6 +69,27 @@ impl Sampler {
         )
     }
 
+    /// Three numbers in [0, 1)³ from one set: a pair as [`Sampler::uniform2`] gives it
+    /// and a third number from Sobol's third dimension, so that the three are stratified
+    /// jointly (a choice among parts and a point on the part chosen fall evenly over the
+    /// whole, as Burley 2020 §4 pads by sets of four dimensions).
+    pub fn uniform3(&mut self) -> (Vec2, f32) {
+        let seed = self.next_set_seed();
+        let index = nested_uniform_scramble(self.index, seed);
+        let pair = Vec2::new(
+            to_unit(scrambled_first(index, seed)),
+            to_unit(nested_uniform_scramble(
+                sobol_second(index),
+                hash_combine(seed, 2),
+            )),
+        );
+        let third = to_unit(nested_uniform_scramble(
+            sobol_third(index),
+            hash_combine(seed, 3),
+        ));
+        (pair, third)
+    }
+
     fn next_set_seed(&mut self) -> u32 {
         let seed = hash_combine(self.pixel_seed, self.set);
         self.set += 1;
@@ -93,9 +117,19 @@ fn sobol_second(index: u32) -> u32 {
         ^ t[3][(index >> 24) as usize]
 }
 
-/// For byte `b` of an index and each value of it, the XOR of the direction numbers of its
-/// set bits.
-const SOBOL_SECOND_BYTES: [[u32; 256]; 4] = {
+/// The third Sobol dimension at `index`: generator matrix from the primitive polynomial
+/// x² + x + 1 with initial numbers m = 1, 3 (Joe & Kuo 2008's table; direction numbers
+/// vᵢ = vᵢ₋₁ ⊕ vᵢ₋₂ ⊕ (vᵢ₋₂ ≫ 2)), by bytes as [`sobol_second`].
+fn sobol_third(index: u32) -> u32 {
+    let t = &SOBOL_THIRD_BYTES;
+    t[0][(index & 0xff) as usize]
+        ^ t[1][((index >> 8) & 0xff) as usize]
+        ^ t[2][((index >> 16) & 0xff) as usize]
+        ^ t[3][(index >> 24) as usize]
+}
+
+/// The second dimension's direction numbers.
+const SECOND_DIRECTIONS: [u32; 32] = {
     let mut direction = [0u32; 32];
     let mut v = 1u32 << 31;
     let mut i = 0;
@@ -104,6 +138,32 @@ const SOBOL_SECOND_BYTES: [[u32; 256]; 4] = {
         v ^= v >> 1;
         i += 1;
     }
+    direction
+};
+
+/// The third dimension's direction numbers.
+const THIRD_DIRECTIONS: [u32; 32] = {
+    let mut direction = [0u32; 32];
+    direction[0] = 1 << 31;
+    direction[1] = 3 << 30;
+    let mut i = 2;
+    while i < 32 {
+        direction[i] = direction[i - 1] ^ direction[i - 2] ^ (direction[i - 2] >> 2);
+        i += 1;
+    }
+    direction
+};
+
+/// For byte `b` of an index and each value of it, the XOR of the second dimension's
+/// direction numbers of its set bits.
+const SOBOL_SECOND_BYTES: [[u32; 256]; 4] = byte_tables(&SECOND_DIRECTIONS);
+
+/// As [`SOBOL_SECOND_BYTES`], for the third dimension.
+const SOBOL_THIRD_BYTES: [[u32; 256]; 4] = byte_tables(&THIRD_DIRECTIONS);
+
+/// For byte `b` of an index and each value of it, the XOR of the direction numbers of its
+/// set bits.
+const fn byte_tables(direction: &[u32; 32]) -> [[u32; 256]; 4] {
     let mut table = [[0u32; 256]; 4];
     let mut b = 0;
     while b < 4 {
@@ -123,7 +183,7 @@ const SOBOL_SECOND_BYTES: [[u32; 256]; 4] = {
         b += 1;
     }
     table
-};
+}
 
 /// Owen scrambling of the bits of `x` as a nested uniform scramble: each bit flipped by a
 /// hash of the bits above it (Burley 2020, §3: the Laine–Karras permutation on reversed
@@ -225,6 +285,64 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// Every elementary box of volume 2^(1−k) holds exactly two of 2^k points: Sobol's first
+    /// three dimensions form (1, k, 3)-nets, the best base 2 allows in three dimensions
+    /// beside the (0, 2) pair.
+    fn is_three_dimensional_net(points: &[(Vec2, f32)], k: u32) -> bool {
+        let m = k - 1;
+        (0..=m).all(|bits_x| {
+            (0..=m - bits_x).all(|bits_y| {
+                let bits_z = m - bits_x - bits_y;
+                let (nx, ny, nz) = (1usize << bits_x, 1usize << bits_y, 1usize << bits_z);
+                let mut counts = vec![0u8; nx * ny * nz];
+                for (pair, third) in points {
+                    let (x, y) = ((pair.x * nx as f32) as usize, (pair.y * ny as f32) as usize);
+                    let z = (third * nz as f32) as usize;
+                    counts[(z * ny + y) * nx + x] += 1;
+                }
+                counts.iter().all(|&c| c == 2)
+            })
+        })
+    }
+
+    #[test]
+    fn each_triple_of_a_pixels_samples_is_a_net_for_aligned_power_of_two_ranges() {
+        for pixel in 0..20u64 {
+            for (start, k) in [(0u32, 4u32), (0, 8), (64, 6), (256, 8), (4096, 10)] {
+                for set in 0..4 {
+                    let points: Vec<(Vec2, f32)> = (start..start + (1 << k))
+                        .map(|i| {
+                            let mut s = Sampler::for_sample(5, pixel, i);
+                            for _ in 0..set {
+                                s.uniform3();
+                            }
+                            s.uniform3()
+                        })
+                        .collect();
+                    assert!(
+                        is_three_dimensional_net(&points, k),
+                        "pixel {pixel}, samples {start}+2^{k}, set {set}"
+                    );
+                    let pairs: Vec<Vec2> = points.iter().map(|p| p.0).collect();
+                    assert!(is_net(&pairs, k), "pair of pixel {pixel}, set {set}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_third_dimension_starts_as_sobols_does() {
+        // Sobol's third dimension at indices 0..8 (direction numbers 1/2, 3/4, 3/8).
+        let expected = [0.0, 0.5, 0.75, 0.25, 0.375, 0.875, 0.625, 0.125];
+        for (i, e) in expected.iter().enumerate() {
+            assert_eq!(
+                sobol_third(i as u32) as f64 / 2f64.powi(32),
+                *e,
+                "index {i}"
+            );
         }
     }
 

@@ -32,20 +32,20 @@ impl GuidedBsdf<'_> {
         }
     }
 
-    /// Draws an incident direction from the BSDF's numbers (direction pair, then lobe
-    /// choice). With a guide, the pair's first number also chooses the strategy and is
-    /// rescaled within the share chosen, so that each strategy's directions stay
-    /// stratified over the pixel's samples, as the BSDF's alone are. Also gives the
-    /// guide's density and the BSDF's at the direction (the guide's 0 without a guide, or
-    /// for a delta lobe's direction, whose BSDF density is then given as 1): what a
-    /// training record keeps to score other shares.
+    /// Draws an incident direction from the BSDF's set of numbers (direction pair and lobe
+    /// choice, stratified together). With a guide, the pair's first number also chooses
+    /// the strategy and is rescaled within the share chosen, so that each strategy's
+    /// directions stay stratified over the pixel's samples, as the BSDF's alone are. Also
+    /// gives the guide's density and the BSDF's at the direction (the guide's 0 without a
+    /// guide, or for a delta lobe's direction, whose BSDF density is then given as 1): what
+    /// a training record keeps to score other shares.
     pub fn sample_with_densities(
         &self,
         n: Vec3,
         wo: Vec3,
         sampler: &mut Sampler,
     ) -> Option<(BsdfSample, (f32, f32))> {
-        let (u, u_lobe) = (sampler.uniform2(), sampler.uniform());
+        let (u, u_lobe) = sampler.uniform3();
         let Some(guide) = self.guide else {
             let sample = self.bsdf.sample(n, wo, u, u_lobe)?;
             let bsdf_pdf = if sample.is_delta { 1.0 } else { sample.pdf };

@@ -104,23 +104,62 @@ impl LightBounds {
     /// An upper bound on the irradiance the lights inside can bring to a receiver at `p`
     /// with normal `n` (zero `n`: no receiver cosine; pbrt-v4 §12.6.3 with intensity for
     /// power).
+    #[cfg(test)]
     pub fn importance(&self, p: Vec3, n: Vec3) -> f32 {
-        let centre = 0.5 * (self.bounds.min + self.bounds.max);
-        let diagonal = (self.bounds.max - self.bounds.min).length();
-        let d2 = p.distance_squared(centre).max(0.5 * diagonal);
+        Reach::of(self).importance(p, n)
+    }
+}
+
+/// A [`LightBounds`] in the form its importance is computed from, with what does not
+/// depend on the receiver worked out once at build (the same numbers, so the same
+/// importance to the bit).
+#[derive(Clone, Copy, Debug)]
+struct Reach {
+    /// The bounds' centre.
+    centre: Vec3,
+    /// The least squared distance counted (pbrt-v4's: half the bounds' diagonal), so that
+    /// receivers inside the bounds do not divide by nearly zero.
+    least_distance_sq: f32,
+    /// Squared radius of the bounds' bounding sphere.
+    radius_sq: f32,
+    normals: Cone,
+    /// Sine of the normal cone's half-angle.
+    sin_normals: f32,
+    cos_emission: f32,
+    two_sided: bool,
+    intensity: f32,
+}
+
+impl Reach {
+    fn of(b: &LightBounds) -> Reach {
+        let cos_o = b.normals.cos_angle;
+        Reach {
+            centre: 0.5 * (b.bounds.min + b.bounds.max),
+            least_distance_sq: 0.5 * (b.bounds.max - b.bounds.min).length(),
+            radius_sq: (0.25 * (b.bounds.max - b.bounds.min).length_squared()).max(0.0),
+            normals: b.normals,
+            sin_normals: (1.0 - cos_o * cos_o).max(0.0).sqrt(),
+            cos_emission: b.cos_emission,
+            two_sided: b.two_sided,
+            intensity: b.intensity,
+        }
+    }
+
+    /// [`LightBounds::importance`].
+    fn importance(&self, p: Vec3, n: Vec3) -> f32 {
+        let d2 = p.distance_squared(self.centre).max(self.least_distance_sq);
         if d2 == 0.0 || !d2.is_finite() {
             return 0.0;
         }
-        let wi = (p - centre) / d2.sqrt();
+        let wi = (p - self.centre) / d2.sqrt();
         let mut cos_w = self.normals.axis.dot(wi);
         if self.two_sided {
             cos_w = cos_w.abs();
         }
         let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
         // The directions from the box to p lie within θb of wi.
-        let (sin_b, cos_b) = subtended(&self.bounds, p);
-        let cos_o = self.normals.cos_angle;
-        let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
+        let (sin_b, cos_b) = self.subtended(p);
+        let (sin_o, cos_o) = (self.sin_normals, self.normals.cos_angle);
         // θ' = max(0, θw − θo − θb): the smallest angle between an emitting direction and a
         // direction towards p.
         let (sin_x, cos_x) = minus_clamped(sin_w, cos_w, sin_o, cos_o);
@@ -136,6 +175,17 @@ impl LightBounds {
         }
         importance.max(0.0)
     }
+
+    /// (sin, cos) of the half-angle of the cone from `p` that holds the bounds' bounding
+    /// sphere (every direction when `p` is inside it).
+    fn subtended(&self, p: Vec3) -> (f32, f32) {
+        let d2 = p.distance_squared(self.centre);
+        if d2 <= self.radius_sq {
+            return (0.0, -1.0);
+        }
+        let sin2 = self.radius_sq / d2;
+        (sin2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
+    }
 }
 
 /// (sin, cos) of max(0, θa − θb) from the sines and cosines of θa and θb.
@@ -145,19 +195,6 @@ fn minus_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> (f32, f32) {
     } else {
         (sin_a * cos_b - cos_a * sin_b, cos_a * cos_b + sin_a * sin_b)
     }
-}
-
-/// (sin, cos) of the half-angle of the cone from `p` that holds the box's bounding sphere
-/// (every direction when `p` is inside it).
-fn subtended(bounds: &Aabb, p: Vec3) -> (f32, f32) {
-    let centre = 0.5 * (bounds.min + bounds.max);
-    let r2 = (0.25 * (bounds.max - bounds.min).length_squared()).max(0.0);
-    let d2 = p.distance_squared(centre);
-    if d2 <= r2 {
-        return (0.0, -1.0);
-    }
-    let sin2 = r2 / d2;
-    (sin2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
 }
 
 fn angle_between(a: Vec3, b: Vec3) -> f32 {
@@ -177,7 +214,8 @@ const LEAF_LIGHTS: usize = 8;
 
 #[derive(Clone, Debug)]
 struct Node {
-    bounds: LightBounds,
+    /// What the node's lights can send where.
+    reach: Reach,
     /// A leaf's first light in `leaf_lights`, or an inner node's second child (the first
     /// follows it).
     index: u32,
@@ -190,7 +228,7 @@ struct Node {
 pub struct LightTree {
     nodes: Vec<Node>,
     /// The leaves' lights, leaf by leaf.
-    leaf_lights: Vec<(usize, LightBounds)>,
+    leaf_lights: Vec<(usize, Reach)>,
     /// For each light: its path from the root (bit i: second child at depth i), depth and
     /// place in `leaf_lights`, or `None` for a light at infinity or without intensity.
     paths: Vec<Option<(u64, u8, u32)>>,
@@ -269,16 +307,16 @@ impl LightTree {
             for (k, &(light, _)) in lights.iter().enumerate() {
                 self.paths[light] = Some((path, depth, first + k as u32));
             }
-            self.leaf_lights.extend_from_slice(lights);
+            (self.leaf_lights).extend(lights.iter().map(|(l, b)| (*l, Reach::of(b))));
             self.nodes.push(Node {
-                bounds,
+                reach: Reach::of(&bounds),
                 index: first,
                 count: lights.len() as u32,
             });
             return index;
         }
         self.nodes.push(Node {
-            bounds,
+            reach: Reach::of(&bounds),
             index: 0,
             count: 0,
         });
@@ -304,7 +342,7 @@ impl LightTree {
     }
 
     /// The lights of leaf `node`.
-    fn leaf(&self, node: &Node) -> &[(usize, LightBounds)] {
+    fn leaf(&self, node: &Node) -> &[(usize, Reach)] {
         &self.leaf_lights[node.index as usize..(node.index + node.count) as usize]
     }
 
@@ -327,7 +365,7 @@ impl LightTree {
                 let (weights, sum) = self.leaf_weights(root, p, n);
                 (sum, Some(weights))
             }
-            Some(root) => (root.bounds.importance(p, n), None),
+            Some(root) => (root.reach.importance(p, n), None),
         };
         let distant: f32 = self.infinite.iter().map(|(_, d)| d.importance(n)).sum();
         (tree, tree + distant, weights)
@@ -366,8 +404,8 @@ impl LightTree {
                 return choose_in_leaf(self.leaf(here), &weights, sum, u, pmf);
             }
             let (first, second) = (node + 1, here.index as usize);
-            let a = self.nodes[first].bounds.importance(p, n);
-            let b = self.nodes[second].bounds.importance(p, n);
+            let a = self.nodes[first].reach.importance(p, n);
+            let b = self.nodes[second].reach.importance(p, n);
             if a + b == 0.0 || !(a + b).is_finite() {
                 return None;
             }
@@ -402,8 +440,8 @@ impl LightTree {
         for level in 0..depth {
             let here = &self.nodes[node];
             let (first, second) = (node + 1, here.index as usize);
-            let a = self.nodes[first].bounds.importance(p, n);
-            let b = self.nodes[second].bounds.importance(p, n);
+            let a = self.nodes[first].reach.importance(p, n);
+            let b = self.nodes[second].reach.importance(p, n);
             if a + b == 0.0 || !(a + b).is_finite() {
                 return 0.0;
             }
@@ -430,7 +468,7 @@ impl LightTree {
 /// One of a leaf's `lights` in proportion to its `weights` (summing to `sum`), for `u` in
 /// [0, 1), and the probability of the whole choice given `pmf`, that of reaching the leaf.
 fn choose_in_leaf(
-    lights: &[(usize, LightBounds)],
+    lights: &[(usize, Reach)],
     weights: &[f32; LEAF_LIGHTS],
     sum: f32,
     u: f32,
