@@ -33,8 +33,9 @@ use super::sampling::mix64;
 pub struct Sampler {
     /// Hash of (seed, pixel): the scrambles of this pixel's sets derive from it.
     pixel_seed: u32,
-    /// The sample's index among all of the pixel's samples.
-    index: u32,
+    /// The sample's index among all of the pixel's samples, bit-reversed: the form the
+    /// index shuffle takes it in.
+    index_reversed: u32,
     /// The next dimension set.
     set: u32,
 }
@@ -44,29 +45,20 @@ impl Sampler {
     pub fn for_sample(seed: u64, pixel: u64, sample: u32) -> Sampler {
         Sampler {
             pixel_seed: mix64(mix64(seed) ^ pixel) as u32,
-            index: sample,
+            index_reversed: sample.reverse_bits(),
             set: 0,
         }
     }
 
     /// One number in [0, 1), stratified over the pixel's samples.
     pub fn uniform(&mut self) -> f32 {
-        let seed = self.next_set_seed();
-        let index = nested_uniform_scramble(self.index, seed);
-        to_unit(scrambled_first(index, seed))
+        self.next_set().first()
     }
 
     /// Two numbers in [0, 1)², jointly stratified over the pixel's samples.
     pub fn uniform2(&mut self) -> Vec2 {
-        let seed = self.next_set_seed();
-        let index = nested_uniform_scramble(self.index, seed);
-        Vec2::new(
-            to_unit(scrambled_first(index, seed)),
-            to_unit(nested_uniform_scramble(
-                sobol_second(index),
-                hash_combine(seed, 2),
-            )),
-        )
+        let set = self.next_set();
+        Vec2::new(set.first(), set.from_table(&SOBOL_SECOND_BYTES, 2))
     }
 
     /// Three numbers in [0, 1)³ from one set: a pair as [`Sampler::uniform2`] gives it
@@ -74,26 +66,49 @@ impl Sampler {
     /// jointly (a choice among parts and a point on the part chosen fall evenly over the
     /// whole, as Burley 2020 §4 pads by sets of four dimensions).
     pub fn uniform3(&mut self) -> (Vec2, f32) {
-        let seed = self.next_set_seed();
-        let index = nested_uniform_scramble(self.index, seed);
-        let pair = Vec2::new(
-            to_unit(scrambled_first(index, seed)),
-            to_unit(nested_uniform_scramble(
-                sobol_second(index),
-                hash_combine(seed, 2),
-            )),
-        );
-        let third = to_unit(nested_uniform_scramble(
-            sobol_third(index),
-            hash_combine(seed, 3),
-        ));
-        (pair, third)
+        let set = self.next_set();
+        let pair = Vec2::new(set.first(), set.from_table(&SOBOL_SECOND_BYTES, 2));
+        (pair, set.from_table(&SOBOL_THIRD_BYTES, 3))
     }
 
-    fn next_set_seed(&mut self) -> u32 {
+    fn next_set(&mut self) -> Set {
         let seed = hash_combine(self.pixel_seed, self.set);
         self.set += 1;
-        seed
+        Set {
+            seed,
+            // nested_uniform_scramble(index, seed), bit-reversed.
+            shuffled_reversed: laine_karras(self.index_reversed, seed),
+        }
+    }
+}
+
+/// One dimension set of a sample: its seed, and the sample's index shuffled by it, kept
+/// bit-reversed. Bit reversal is a dozen instructions on x86-64, and each Owen scramble
+/// works on reversed bits, so the index and the tables stay in that form and each number
+/// is reversed once, at the end.
+struct Set {
+    seed: u32,
+    shuffled_reversed: u32,
+}
+
+impl Set {
+    /// The set's first dimension.
+    #[inline]
+    fn first(&self) -> f32 {
+        to_unit(scrambled_first(
+            self.shuffled_reversed.reverse_bits(),
+            self.seed,
+        ))
+    }
+
+    /// Dimension `dimension` (2 or 3), from its byte tables over reversed indices,
+    /// Owen-scrambled: `nested_uniform_scramble(sobol(index), s)` is
+    /// `laine_karras(sobol(index).reverse_bits(), s).reverse_bits()`, and the tables give
+    /// `sobol(index).reverse_bits()` from the reversed index directly.
+    #[inline]
+    fn from_table(&self, tables: &[[u32; 256]; 4], dimension: u32) -> f32 {
+        let x = sobol_by_bytes(tables, self.shuffled_reversed);
+        to_unit(laine_karras(x, hash_combine(self.seed, dimension)).reverse_bits())
     }
 }
 
@@ -104,31 +119,19 @@ fn scrambled_first(index: u32, seed: u32) -> u32 {
     laine_karras(index, hash_combine(seed, 1)).reverse_bits()
 }
 
-/// The second Sobol dimension at `index`: generator matrix from the primitive polynomial
-/// x + 1 (direction numbers v₀ = 2³¹, vᵢ = vᵢ₋₁ ⊕ (vᵢ₋₁ ≫ 1)). The result is the XOR of the
-/// direction numbers of the index's set bits, taken a byte at a time from
-/// [`SOBOL_SECOND_BYTES`]: shuffled indices have random high bits, so a loop over the bits
-/// would branch unpredictably 32 times per number.
-fn sobol_second(index: u32) -> u32 {
-    let t = &SOBOL_SECOND_BYTES;
-    t[0][(index & 0xff) as usize]
-        ^ t[1][((index >> 8) & 0xff) as usize]
-        ^ t[2][((index >> 16) & 0xff) as usize]
-        ^ t[3][(index >> 24) as usize]
+/// The XOR of the direction numbers of the set bits of `x`, a byte at a time from `tables`
+/// (built by [`byte_tables`]): shuffled indices have random high bits, so a loop over the
+/// bits would branch unpredictably 32 times per number.
+#[inline]
+fn sobol_by_bytes(tables: &[[u32; 256]; 4], x: u32) -> u32 {
+    tables[0][(x & 0xff) as usize]
+        ^ tables[1][((x >> 8) & 0xff) as usize]
+        ^ tables[2][((x >> 16) & 0xff) as usize]
+        ^ tables[3][(x >> 24) as usize]
 }
 
-/// The third Sobol dimension at `index`: generator matrix from the primitive polynomial
-/// x² + x + 1 with initial numbers m = 1, 3 (Joe & Kuo 2008's table; direction numbers
-/// vᵢ = vᵢ₋₁ ⊕ vᵢ₋₂ ⊕ (vᵢ₋₂ ≫ 2)), by bytes as [`sobol_second`].
-fn sobol_third(index: u32) -> u32 {
-    let t = &SOBOL_THIRD_BYTES;
-    t[0][(index & 0xff) as usize]
-        ^ t[1][((index >> 8) & 0xff) as usize]
-        ^ t[2][((index >> 16) & 0xff) as usize]
-        ^ t[3][(index >> 24) as usize]
-}
-
-/// The second dimension's direction numbers.
+/// The second Sobol dimension's direction numbers: generator matrix from the primitive
+/// polynomial x + 1 (v₀ = 2³¹, vᵢ = vᵢ₋₁ ⊕ (vᵢ₋₁ ≫ 1)).
 const SECOND_DIRECTIONS: [u32; 32] = {
     let mut direction = [0u32; 32];
     let mut v = 1u32 << 31;
@@ -141,7 +144,9 @@ const SECOND_DIRECTIONS: [u32; 32] = {
     direction
 };
 
-/// The third dimension's direction numbers.
+/// The third Sobol dimension's direction numbers: generator matrix from the primitive
+/// polynomial x² + x + 1 with initial numbers m = 1, 3 (Joe & Kuo 2008's table;
+/// vᵢ = vᵢ₋₁ ⊕ vᵢ₋₂ ⊕ (vᵢ₋₂ ≫ 2)).
 const THIRD_DIRECTIONS: [u32; 32] = {
     let mut direction = [0u32; 32];
     direction[0] = 1 << 31;
@@ -154,12 +159,23 @@ const THIRD_DIRECTIONS: [u32; 32] = {
     direction
 };
 
-/// For byte `b` of an index and each value of it, the XOR of the second dimension's
-/// direction numbers of its set bits.
-const SOBOL_SECOND_BYTES: [[u32; 256]; 4] = byte_tables(&SECOND_DIRECTIONS);
+/// The second dimension by bytes of the reversed index, bit-reversed.
+const SOBOL_SECOND_BYTES: [[u32; 256]; 4] = byte_tables(&reversed(&SECOND_DIRECTIONS));
 
-/// As [`SOBOL_SECOND_BYTES`], for the third dimension.
-const SOBOL_THIRD_BYTES: [[u32; 256]; 4] = byte_tables(&THIRD_DIRECTIONS);
+/// The third dimension by bytes of the reversed index, bit-reversed.
+const SOBOL_THIRD_BYTES: [[u32; 256]; 4] = byte_tables(&reversed(&THIRD_DIRECTIONS));
+
+/// Direction numbers for a bit-reversed index, giving bit-reversed values: bit j of the
+/// reversed index is bit 31 − j of the index.
+const fn reversed(direction: &[u32; 32]) -> [u32; 32] {
+    let mut out = [0u32; 32];
+    let mut j = 0;
+    while j < 32 {
+        out[j] = direction[31 - j].reverse_bits();
+        j += 1;
+    }
+    out
+}
 
 /// For byte `b` of an index and each value of it, the XOR of the direction numbers of its
 /// set bits.
@@ -183,13 +199,6 @@ const fn byte_tables(direction: &[u32; 32]) -> [[u32; 256]; 4] {
         b += 1;
     }
     table
-}
-
-/// Owen scrambling of the bits of `x` as a nested uniform scramble: each bit flipped by a
-/// hash of the bits above it (Burley 2020, §3: the Laine–Karras permutation on reversed
-/// bits, with Burley's improved constants).
-fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
-    laine_karras(x.reverse_bits(), seed).reverse_bits()
 }
 
 /// The Laine–Karras permutation with Burley's constants: each bit of `v` flipped by a hash
@@ -242,6 +251,23 @@ mod tests {
         x
     }
 
+    /// Owen scrambling of the bits of `x` as a nested uniform scramble: each bit flipped by
+    /// a hash of the bits above it (Burley 2020, §3: the Laine–Karras permutation on
+    /// reversed bits, with Burley's improved constants).
+    fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
+        laine_karras(x.reverse_bits(), seed).reverse_bits()
+    }
+
+    /// The second dimension at `index` from the tables, as its definition takes it.
+    fn sobol_second(index: u32) -> u32 {
+        sobol_by_bytes(&SOBOL_SECOND_BYTES, index.reverse_bits()).reverse_bits()
+    }
+
+    /// The third dimension at `index` from the tables.
+    fn sobol_third(index: u32) -> u32 {
+        sobol_by_bytes(&SOBOL_THIRD_BYTES, index.reverse_bits()).reverse_bits()
+    }
+
     #[test]
     fn the_byte_tables_give_the_second_dimension_bit_for_bit() {
         let mut h = 1u32;
@@ -249,6 +275,35 @@ mod tests {
             h = h.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
             for index in [i, h, h | 0x8000_0000, u32::MAX - i] {
                 assert_eq!(sobol_second(index), sobol_second_by_bits(index), "{index}");
+            }
+        }
+    }
+
+    /// A set as Burley's paper writes it: the index shuffled by a nested uniform scramble,
+    /// each dimension's value scrambled by its own.
+    fn set_by_definition(pixel_seed: u32, set: u32, index: u32) -> (f32, f32, f32) {
+        let seed = hash_combine(pixel_seed, set);
+        let shuffled = nested_uniform_scramble(index, seed);
+        let scramble = |x: u32, d: u32| to_unit(nested_uniform_scramble(x, hash_combine(seed, d)));
+        (
+            scramble(shuffled.reverse_bits(), 1),
+            scramble(sobol_second_by_bits(shuffled), 2),
+            scramble(sobol_third(shuffled), 3),
+        )
+    }
+
+    #[test]
+    fn the_sets_are_the_definitions_numbers_to_the_bit() {
+        for (seed, pixel) in [(0u64, 0u64), (7, 12_345), (u64::MAX, 99)] {
+            for index in [0u32, 1, 2, 3, 17, 255, 256, 65_537, 1 << 31, u32::MAX] {
+                let mut s = Sampler::for_sample(seed, pixel, index);
+                let one = s.uniform();
+                let two = s.uniform2();
+                let (pair, third) = s.uniform3();
+                let d = |set| set_by_definition(s.pixel_seed, set, index);
+                assert_eq!(one, d(0).0);
+                assert_eq!((two.x, two.y), (d(1).0, d(1).1));
+                assert_eq!((pair.x, pair.y, third), d(2));
             }
         }
     }
