@@ -58,7 +58,7 @@ impl Sampler {
     /// Two numbers in [0, 1)², jointly stratified over the pixel's samples.
     pub fn uniform2(&mut self) -> Vec2 {
         let set = self.next_set();
-        Vec2::new(set.first(), set.from_table(&SOBOL_SECOND_BYTES, 2))
+        Vec2::new(set.first(), set.dimension(&SOBOL_SECOND_BYTES, 2))
     }
 
     /// Three numbers in [0, 1)³ from one set: a pair as [`Sampler::uniform2`] gives it
@@ -67,8 +67,8 @@ impl Sampler {
     /// whole, as Burley 2020 §4 pads by sets of four dimensions).
     pub fn uniform3(&mut self) -> (Vec2, f32) {
         let set = self.next_set();
-        let pair = Vec2::new(set.first(), set.from_table(&SOBOL_SECOND_BYTES, 2));
-        (pair, set.from_table(&SOBOL_THIRD_BYTES, 3))
+        let pair = Vec2::new(set.first(), set.dimension(&SOBOL_SECOND_BYTES, 2));
+        (pair, set.dimension(&SOBOL_THIRD_BYTES, 3))
     }
 
     fn next_set(&mut self) -> Set {
@@ -106,7 +106,7 @@ impl Set {
     /// `laine_karras(sobol(index).reverse_bits(), s).reverse_bits()`, and the tables give
     /// `sobol(index).reverse_bits()` from the reversed index directly.
     #[inline]
-    fn from_table(&self, tables: &[[u32; 256]; 4], dimension: u32) -> f32 {
+    fn dimension(&self, tables: &[[u32; 256]; 4], dimension: u32) -> f32 {
         let x = sobol_by_bytes(tables, self.shuffled_reversed);
         to_unit(laine_karras(x, hash_combine(self.seed, dimension)).reverse_bits())
     }
