@@ -101,6 +101,22 @@ impl Entry {
     }
 }
 
+/// The box among `set` (box `i` in bit `i`, at least one) whose entry distance in `start`
+/// is least; the lowest index among equals.
+#[inline(always)]
+fn nearest_of(set: u32, start: &[f32]) -> usize {
+    let mut nearest = set.trailing_zeros() as usize;
+    let mut rest = set & (set - 1);
+    while rest != 0 {
+        let i = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        if start[i] < start[nearest] {
+            nearest = i;
+        }
+    }
+    nearest
+}
+
 /// How the build places one scene instance.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Placement {
@@ -243,11 +259,17 @@ impl SceneAccel {
                 for _ in &self.entries {
                     stats.test_instance();
                 }
-                // Only the entries whose bounds the ray meets, in order.
+                // Only the entries whose bounds the ray meets, nearest entry first: a hit
+                // in a near entry ends the ray before the far ones, which are then not
+                // searched at all.
                 let mut met = slabs.met();
                 while met != 0 {
-                    let e = met.trailing_zeros() as usize;
-                    met &= met - 1;
+                    let e = nearest_of(met, &slabs.start);
+                    met &= !(1 << e);
+                    // Every entry left starts at or beyond this one's start.
+                    if slabs.start[e] > t_max {
+                        break;
+                    }
                     // A hit found since may have brought the end before this entry.
                     if !slabs.hits(e, t_max) {
                         continue;
@@ -704,6 +726,16 @@ mod tests {
                 "{case}: {hits} hits, {blocked} blocked"
             );
         }
+    }
+
+    #[test]
+    fn the_nearest_box_is_taken_first_and_the_lowest_index_among_equals() {
+        let start = [3.0, 1.0, 2.0, 1.0, 0.5];
+        assert_eq!(nearest_of(0b01111, &start), 1);
+        assert_eq!(nearest_of(0b00101, &start), 2);
+        assert_eq!(nearest_of(0b01101, &start), 3);
+        assert_eq!(nearest_of(0b11111, &start), 4);
+        assert_eq!(nearest_of(0b00001, &start), 0);
     }
 
     /// An entry whose grid takes world rays as they are, met after a nearer hit in an entry
