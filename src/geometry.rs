@@ -83,15 +83,26 @@ pub const fn gamma(n: i32) -> f32 {
     e / (1.0 - e)
 }
 
-/// A point transformed by `m`, and a bound on the rounding error that added.
-pub fn transform_point_with_error(m: &Affine3A, p: Vec3) -> (Vec3, Vec3) {
+/// Points transformed by `m`, each with a bound on the rounding error that added (the
+/// matrix's absolute values taken once for all of them).
+pub fn transform_points_with_error<const N: usize>(
+    m: &Affine3A,
+    points: [Vec3; N],
+) -> [(Vec3, Vec3); N] {
     let abs = Mat3::from_cols(
         m.matrix3.x_axis.abs().into(),
         m.matrix3.y_axis.abs().into(),
         m.matrix3.z_axis.abs().into(),
     );
-    let error = gamma(3) * (abs * p.abs() + Vec3::from(m.translation).abs());
-    (m.transform_point3(p), error)
+    let translation = Vec3::from(m.translation).abs();
+    let mut placed = [(Vec3::ZERO, Vec3::ZERO); N];
+    for (out, p) in placed.iter_mut().zip(points) {
+        *out = (
+            m.transform_point3(p),
+            gamma(3) * (abs * p.abs() + translation),
+        );
+    }
+    placed
 }
 
 /// Interpolates three corners (with their error bounds) at barycentrics (b0, b1, b2), and

@@ -4,7 +4,7 @@
 use glam::{Affine3A, Mat3, Vec3};
 
 use crate::accel::SceneHit;
-use crate::geometry::{interpolate_with_error, transform_point_with_error};
+use crate::geometry::{interpolate_with_error, transform_points_with_error};
 use crate::scene::Scene;
 
 /// The local geometry at a ray hit, in world space.
@@ -76,7 +76,7 @@ pub fn surface_at(scene: &Scene, frames: &[InstanceFrame], hit: &SceneHit) -> Su
     // front even under mirroring transforms.
     let geometric = (frame.normal_matrix * (p[1] - p[0]).cross(p[2] - p[0])).normalize_or_zero();
     let w = 1.0 - hit.u - hit.v;
-    let corners = p.map(|p| transform_point_with_error(&frame.world_from_object, p));
+    let corners = transform_points_with_error(&frame.world_from_object, p);
     let (point, point_error) = interpolate_with_error(corners, [w, hit.u, hit.v]);
     let shading = if mesh.normals.is_empty() {
         geometric

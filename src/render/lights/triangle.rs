@@ -11,7 +11,7 @@ use super::sample::LightSample;
 use super::spherical;
 use super::tree::{Cone, LightBounds, TreeInput};
 use crate::geometry::Aabb;
-use crate::geometry::{interpolate_with_error, transform_point_with_error};
+use crate::geometry::{interpolate_with_error, transform_points_with_error};
 use crate::render::sampling::uniform_triangle;
 use crate::scene::{ColorSpace, Motion, Scene, TextureRef, TimeSlice};
 
@@ -49,7 +49,7 @@ impl PlacedTriangle {
     /// winding; the normal follows the object-space front face, which is what the
     /// renderer's hit normal uses too.
     fn new(m: &Affine3A, object: [Vec3; 3]) -> PlacedTriangle {
-        let corners = object.map(|p| transform_point_with_error(m, p));
+        let corners = transform_points_with_error(m, object);
         let [p0, p1, p2] = corners.map(|c| c.0);
         let cross = (p1 - p0).cross(p2 - p0);
         let area = 0.5 * cross.length();
