@@ -13,7 +13,9 @@ per core). Error is the mean squared error against the reference's mean (the two
 tests/data/references), less the reference's own noise (the halves' squared difference / 4);
 time is the time spent sampling: gridtrace's reported render time (loading excluded), and
 for Cycles the time of the N-sample render less that of a 1-sample render (scene sync and
-BVH build), scaled by N / (N - 1). Efficiency is 1 / (MSE x time); the table gives both
+BVH build), scaled by N / (N - 1). The renderers take turns seed by seed; error is the
+mean over the seeds, time the median (one slow spell of the shared machine moves a mean by
+a third). Efficiency is 1 / (MSE x time); the table gives both
 renderers' figures and their ratio (gridtrace / Cycles, higher is better). With
 `--guiding`, gridtrace also renders every measurement with `--guiding on` in the same run,
 and the table gains the guided figures and their ratio to Cycles.
@@ -99,20 +101,25 @@ def main():
                     use_exact_models(mat)
             overhead = min(cycles_render(scene, 1, 100 + r, out) for r in range(args.repeats))
             for spp in args.spp:
-                measured = {}
-                for who in renderers:
-                    errors, times = [], []
-                    for r in range(args.repeats):
-                        seed = 10 + r
+                errors = {who: [] for who in renderers}
+                times = {who: [] for who in renderers}
+                # The renderers take turns, seed by seed, so that a slow spell of the shared
+                # machine falls on all of them.
+                for r in range(args.repeats):
+                    seed = 10 + r
+                    for who in renderers:
                         if who == "cycles":
                             t = (cycles_render(scene, spp, seed, out) - overhead) * spp / (spp - 1)
                         else:
                             guiding = "on" if who == "guided" else "off"
                             t = gridtrace_render(args.gridtrace, scene_file(name), spp, seed, out,
                                                  guiding)
-                        errors.append(max(np.mean((read_rgb(out) - ref) ** 2) - ref_noise, 1e-12))
-                        times.append(max(t, 1e-3))
-                    mse, seconds = float(np.mean(errors)), float(np.mean(times))
+                        errors[who].append(
+                            max(np.mean((read_rgb(out) - ref) ** 2) - ref_noise, 1e-12))
+                        times[who].append(max(t, 1e-3))
+                measured = {}
+                for who in renderers:
+                    mse, seconds = float(np.mean(errors[who])), float(np.median(times[who]))
                     measured[who] = (mse, seconds, 1.0 / (mse * seconds))
                 rows.append((name, spp, measured))
                 g, c = measured["gridtrace"], measured["cycles"]
