@@ -10,7 +10,8 @@
 #
 # Each binary renders SCENE at 64 x 64, 16 spp, seed 1, 64 bounces, on one thread
 # (RENDER_SPP and RENDER_SIZE change the first two); about half a minute per binary for the
-# bundled scenes. RENDER_TOP=N also prints each binary's N costliest functions.
+# bundled scenes. RENDER_TOP=N also prints each binary's N costliest functions (columns:
+# instructions, conditional branches and their mispredictions, indirect branches and theirs).
 set -euo pipefail
 scene=${1:?usage: tools/dev/render-instructions.sh SCENE BINARY...}
 shift
