@@ -100,14 +100,6 @@ impl LightBounds {
             two_sided: self.two_sided || other.two_sided,
         }
     }
-
-    /// An upper bound on the irradiance the lights inside can bring to a receiver at `p`
-    /// with normal `n` (zero `n`: no receiver cosine; pbrt-v4 §12.6.3 with intensity for
-    /// power).
-    #[cfg(test)]
-    pub fn importance(&self, p: Vec3, n: Vec3) -> f32 {
-        Reach::of(self).importance(p, n)
-    }
 }
 
 /// A [`LightBounds`] in the form its importance is computed from, with what does not
@@ -145,7 +137,9 @@ impl Reach {
         }
     }
 
-    /// [`LightBounds::importance`].
+    /// An upper bound on the irradiance the lights inside can bring to a receiver at `p`
+    /// with normal `n` (zero `n`: no receiver cosine; pbrt-v4 §12.6.3 with intensity for
+    /// power).
     fn importance(&self, p: Vec3, n: Vec3) -> f32 {
         let d2 = p.distance_squared(self.centre).max(self.least_distance_sq);
         if d2 == 0.0 || !d2.is_finite() {
