@@ -494,7 +494,8 @@ impl Renderer<'_> {
         } else {
             -s.geometric_normal
         };
-        let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo);
+        let mut changed = None;
+        let (bsdf, ns) = shading.oriented(s.shading_normal, ng, wo, &mut changed);
         let (guide, fraction) = match options.guiding.guide() {
             Some(g) if bsdf.is_guidable() => {
                 let (distribution, fraction) = g.at(s.point);
@@ -509,7 +510,7 @@ impl Renderer<'_> {
             _ => (None, 0.0),
         };
         let scatter = GuidedBsdf {
-            bsdf: &bsdf,
+            bsdf,
             guide,
             fraction,
         };

@@ -41,7 +41,17 @@ impl Shading<'_> {
     /// ([`valid_reflection_normal`]), while the diffuse base and sheen keep the shading
     /// normal and, where a normal map bent it away from the interpolated `smooth` normal,
     /// take the bump shadowing.
-    pub fn oriented(&self, smooth: Vec3, ng: Vec3, wo: Vec3) -> (Cow<'_, Bsdf>, Vec3) {
+    ///
+    /// A BSDF that must change is written into `changed` and borrowed from there; the
+    /// caller's slot, rather than a returned `Cow`, because moving a `Cow<Bsdf>` copies
+    /// all of its few hundred bytes even when it only borrows (a `memcpy` at every vertex).
+    pub fn oriented<'s>(
+        &'s self,
+        smooth: Vec3,
+        ng: Vec3,
+        wo: Vec3,
+        changed: &'s mut Option<Bsdf>,
+    ) -> (&'s Bsdf, Vec3) {
         let side = if self.normal.dot(ng) < 0.0 { -1.0 } else { 1.0 };
         let diffuse = side * self.normal;
         let n = valid_reflection_normal(ng, wo, diffuse);
@@ -50,7 +60,7 @@ impl Shading<'_> {
             && self.normal == smooth
             && self.anisotropy_direction.is_none();
         if unchanged {
-            return (Cow::Borrowed(&*self.bsdf), n);
+            return (&self.bsdf, n);
         }
         let mut bsdf = match self.coat_normal {
             Some(coat) => self
@@ -67,7 +77,7 @@ impl Shading<'_> {
         if let Some(direction) = self.anisotropy_direction {
             bsdf = bsdf.with_tangent(n, direction);
         }
-        (Cow::Owned(bsdf), n)
+        (changed.insert(bsdf), n)
     }
 }
 
