@@ -64,7 +64,7 @@ impl Sampler {
     /// Three numbers in [0, 1)³ from one set: a pair as [`Sampler::uniform2`] gives it
     /// and a third number from Sobol's third dimension, so that the three are stratified
     /// jointly (a choice among parts and a point on the part chosen fall evenly over the
-    /// whole, as Burley 2020 §4 pads by sets of four dimensions).
+    /// whole; Burley 2020 pads by four-dimensional Sobol sets).
     pub fn uniform3(&mut self) -> (Vec2, f32) {
         let set = self.next_set();
         let pair = Vec2::new(set.first(), set.dimension(&SOBOL_SECOND_BYTES, 2));
