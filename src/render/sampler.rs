@@ -320,27 +320,45 @@ mod tests {
         })
     }
 
-    #[test]
-    fn each_pair_of_a_pixels_samples_is_a_net_for_aligned_power_of_two_ranges() {
+    /// Aligned power-of-two ranges of sample indices (start, log₂ length), as `--samples`
+    /// splits usually are.
+    const ALIGNED_RANGES: [(u32, u32); 5] = [(0, 4), (0, 8), (64, 6), (256, 8), (4096, 10)];
+
+    /// For 20 pixels, each range and each of `sets` sets: what `draw` gives at that set over
+    /// the range's samples, with the pixel, range and set it came from.
+    fn each_set_over_ranges<T>(
+        seed: u64,
+        sets: usize,
+        draw: impl Fn(&mut Sampler) -> T,
+        mut check: impl FnMut(Vec<T>, u32, String),
+    ) {
         for pixel in 0..20u64 {
-            for (start, k) in [(0u32, 4u32), (0, 8), (64, 6), (256, 8), (4096, 10)] {
-                for set in 0..6 {
-                    let points: Vec<Vec2> = (start..start + (1 << k))
+            for (start, k) in ALIGNED_RANGES {
+                for set in 0..sets {
+                    let points = (start..start + (1 << k))
                         .map(|i| {
-                            let mut s = Sampler::for_sample(7, pixel, i);
+                            let mut s = Sampler::for_sample(seed, pixel, i);
                             for _ in 0..set {
-                                s.uniform2();
+                                draw(&mut s);
                             }
-                            s.uniform2()
+                            draw(&mut s)
                         })
                         .collect();
-                    assert!(
-                        is_net(&points, k),
-                        "pixel {pixel}, samples {start}+2^{k}, set {set}"
+                    check(
+                        points,
+                        k,
+                        format!("pixel {pixel}, samples {start}+2^{k}, set {set}"),
                     );
                 }
             }
         }
+    }
+
+    #[test]
+    fn each_pair_of_a_pixels_samples_is_a_net_for_aligned_power_of_two_ranges() {
+        each_set_over_ranges(7, 6, Sampler::uniform2, |points, k, at| {
+            assert!(is_net(&points, k), "{at}");
+        });
     }
 
     /// Every elementary box of volume 2^(1−k) holds exactly two of 2^k points: Sobol's first
@@ -365,27 +383,11 @@ mod tests {
 
     #[test]
     fn each_triple_of_a_pixels_samples_is_a_net_for_aligned_power_of_two_ranges() {
-        for pixel in 0..20u64 {
-            for (start, k) in [(0u32, 4u32), (0, 8), (64, 6), (256, 8), (4096, 10)] {
-                for set in 0..4 {
-                    let points: Vec<(Vec2, f32)> = (start..start + (1 << k))
-                        .map(|i| {
-                            let mut s = Sampler::for_sample(5, pixel, i);
-                            for _ in 0..set {
-                                s.uniform3();
-                            }
-                            s.uniform3()
-                        })
-                        .collect();
-                    assert!(
-                        is_three_dimensional_net(&points, k),
-                        "pixel {pixel}, samples {start}+2^{k}, set {set}"
-                    );
-                    let pairs: Vec<Vec2> = points.iter().map(|p| p.0).collect();
-                    assert!(is_net(&pairs, k), "pair of pixel {pixel}, set {set}");
-                }
-            }
-        }
+        each_set_over_ranges(5, 4, Sampler::uniform3, |points, k, at| {
+            assert!(is_three_dimensional_net(&points, k), "{at}");
+            let pairs: Vec<Vec2> = points.iter().map(|p| p.0).collect();
+            assert!(is_net(&pairs, k), "pair of {at}");
+        });
     }
 
     #[test]
