@@ -56,6 +56,13 @@ pub fn sphere_z_score(
     (z, chi2, dof)
 }
 
+/// The value a χ² statistic with `dof` degrees of freedom exceeds with probability 10⁻⁴
+/// (z = 3.719 through Wilson–Hilferty): the limit of tests with equal or known bin shares.
+pub fn upper_point(dof: f64) -> f64 {
+    let z = 3.719;
+    dof * (1.0 - 2.0 / (9.0 * dof) + z * (2.0 / (9.0 * dof)).sqrt()).powi(3)
+}
+
 /// χ² over bins with expected count ≥ 5, the rest pooled into one bin.
 fn pooled_chi_square(observed: &[f64], expected: &[f64]) -> (f64, usize) {
     let (mut chi2, mut dof) = (0.0, 0usize);

@@ -425,10 +425,10 @@ mod tests {
             .iter()
             .map(|&c| (c as f64 - expected).powi(2) / expected)
             .sum();
-        let dof = (counts.len() - 1) as f64;
-        let z = 3.719;
-        let limit = dof * (1.0 - 2.0 / (9.0 * dof) + z * (2.0 / (9.0 * dof)).sqrt()).powi(3);
-        (chi, limit)
+        (
+            chi,
+            crate::render::chi_square::upper_point((counts.len() - 1) as f64),
+        )
     }
 
     #[test]

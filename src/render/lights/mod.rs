@@ -7,9 +7,11 @@
 
 mod environment;
 mod punctual;
+mod quad;
 mod sample;
 mod sphere;
 mod spherical;
+mod spherical_rectangle;
 mod tree;
 mod triangle;
 
@@ -22,12 +24,13 @@ pub use triangle::EmissiveTriangles;
 use super::sampling::Distribution1d;
 use crate::scene::{LightKind, Scene};
 use tree::{LightTree, TreeInput};
+use triangle::Emitter;
 
 /// One light of a [`LightSet`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Light {
-    /// An emissive triangle, by index into the set's triangles.
-    Triangle(usize),
+    /// An emissive triangle or rectangle.
+    Emissive(Emitter),
     /// A light of the scene's own, by index into the scene's lights.
     Punctual(usize),
     /// The environment.
@@ -40,9 +43,11 @@ pub struct LightSet {
     triangles: EmissiveTriangles,
     punctual: Vec<LightKind>,
     environment: Option<EnvironmentLight>,
-    /// What each entry of `distribution` is: the triangles, then the punctual lights, then
-    /// the environment.
+    /// What each entry of `distribution` is: the triangles' emitters, then the punctual
+    /// lights, then the environment.
     lights: Vec<Light>,
+    /// For each emissive triangle, the index in `lights` of the emitter it belongs to.
+    light_of_triangle: Vec<u32>,
     /// Over `lights`, by power: the scene's total, and whether anything emits.
     distribution: Distribution1d,
     /// Chooses among `lights` for each shading point.
@@ -77,14 +82,16 @@ impl LightSet {
             .as_ref()
             .filter(|e| !e.is_black())
             .map(EnvironmentLight::new);
-        let mut lights: Vec<Light> = (0..triangles.len()).map(Light::Triangle).collect();
+        let emitters = triangles.emitters();
+        let light_of_triangle = triangles.emitter_indices(&emitters);
+        let mut lights: Vec<Light> = emitters.iter().map(|&e| Light::Emissive(e)).collect();
         lights.extend((0..punctual.len()).map(Light::Punctual));
         let environment_index = environment.as_ref().map(|_| {
             lights.push(Light::Environment);
             lights.len() - 1
         });
         // Powers in the order of `lights`.
-        let mut weights = triangles.powers(scene);
+        let mut weights = triangles.powers(scene, &emitters);
         weights.extend(punctual.iter().map(|l| l.power(scene_radius)));
         weights.extend(
             environment
@@ -96,7 +103,7 @@ impl LightSet {
             .iter()
             .zip(&weights)
             .map(|(&light, &power)| match light {
-                Light::Triangle(i) => triangles.tree_input(i, power),
+                Light::Emissive(e) => triangles.tree_input(e, power),
                 Light::Punctual(i) => punctual::tree_input(&punctual[i]),
                 Light::Environment => EnvironmentLight::tree_input(power, disc),
             })
@@ -120,6 +127,7 @@ impl LightSet {
             punctual,
             environment,
             lights,
+            light_of_triangle,
             environment_index,
             punctual_distribution,
             spheres,
@@ -172,7 +180,7 @@ impl LightSet {
     ) -> Option<LightSample> {
         let (index, pmf) = self.tree.choose(p, n, u_light)?;
         match self.lights[index] {
-            Light::Triangle(i) => self.triangles.sample(scene, i, pmf, p, time, u),
+            Light::Emissive(e) => self.triangles.sample(scene, e, pmf, p, time, u),
             Light::Punctual(i) => {
                 punctual::sample(&self.punctual[i], pmf, p, self.beyond_the_scene(p), u)
             }
@@ -181,6 +189,11 @@ impl LightSet {
                 self.environment.as_ref()?.sample_from(pmf, p, far, u)
             }
         }
+    }
+
+    /// The index in `lights` of the first punctual light.
+    fn punctual_start(&self) -> usize {
+        self.lights.len() - self.punctual.len() - usize::from(self.environment_index.is_some())
     }
 
     /// A distance from `p` that takes a segment past all of the scene.
@@ -233,7 +246,7 @@ impl LightSet {
             {
                 let pmf = self
                     .tree
-                    .pmf(self.triangles.len() + i, vertex, vertex_normal);
+                    .pmf(self.punctual_start() + i, vertex, vertex_normal);
                 found(radiance, pmf * punctual::sphere_pdf(light, vertex, d), t);
             }
         }
@@ -262,7 +275,8 @@ impl LightSet {
         let Some(index) = self.triangles.index_of(instance, triangle) else {
             return 0.0;
         };
-        let pmf = || self.tree.pmf(index, origin, origin_normal);
+        let light = self.light_of_triangle[index] as usize;
+        let pmf = || self.tree.pmf(light, origin, origin_normal);
         self.triangles
             .pdf(index, pmf, time, origin, distance, cos_light)
     }
@@ -271,7 +285,77 @@ impl LightSet {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{Light as SceneLight, SceneBuilder};
+    use crate::scene::{Light as SceneLight, Material, SceneBuilder};
+
+    /// A square lamp of two triangles and a lone triangle beside it.
+    fn lamps(square: [Vec3; 4]) -> Scene {
+        let mut builder = SceneBuilder::new();
+        let light = builder.add_material(Material {
+            double_sided: false,
+            ..Material::diffuse("light", Vec3::ZERO).with_emission(Vec3::splat(4.0))
+        });
+        let lone = [
+            Vec3::new(3.0, 2.0, 0.0),
+            Vec3::new(4.0, 2.0, 0.0),
+            Vec3::new(3.0, 2.0, 1.0),
+        ];
+        let mut positions = square.to_vec();
+        positions.extend(lone);
+        let indices = vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]];
+        let mesh = builder.add_mesh("lamps", positions, indices, light);
+        builder.add_instance(mesh, glam::Affine3A::IDENTITY, "test");
+        builder.build()
+    }
+
+    #[test]
+    fn a_rectangle_of_two_triangles_is_one_light_that_rays_find_with_its_own_density() {
+        // Facing down (wound clockwise seen from above), 1 × 0.6 at height 2.
+        let square = [
+            Vec3::new(-0.5, 2.0, -0.3),
+            Vec3::new(-0.5, 2.0, 0.3),
+            Vec3::new(0.5, 2.0, 0.3),
+            Vec3::new(0.5, 2.0, -0.3),
+        ];
+        let scene = lamps(square);
+        let set = LightSet::build(&scene);
+        assert_eq!(
+            set.lights,
+            [
+                Light::Emissive(Emitter::Quad(0)),
+                Light::Emissive(Emitter::Triangle(2))
+            ]
+        );
+        // From near (sampled by solid angle) and from far below (by area), each sample lands
+        // on the lamp, and the density MIS would give a ray that found that point is the
+        // one the sample was drawn with.
+        let mut rng = crate::render::sampling::Rng::new(7, 3);
+        let mut halves = [0; 2];
+        for p in [Vec3::new(0.2, 1.4, 0.1), Vec3::new(0.0, -30.0, 0.0)] {
+            for _ in 0..2000 {
+                let u = rng.uniform2();
+                let Some(s) = set.sample(&scene, p, Vec3::Y, 0.0, 0.1, u) else {
+                    continue;
+                };
+                if s.point.x > 2.0 {
+                    continue; // the lone triangle
+                }
+                assert!((s.point.y - 2.0).abs() < 1e-5 && s.point.x.abs() <= 0.5 + 1e-5);
+                assert!(s.point.z.abs() <= 0.3 + 1e-5, "{}", s.point);
+                // Which triangle the point is on: the diagonal from (-0.5, -0.3) to (0.5, 0.3).
+                let triangle = u32::from(s.point.z * 1.0 < s.point.x * 0.6);
+                halves[triangle as usize] += 1;
+                let cos_light = s.normal.dot(-s.wi);
+                let pdf = set.pdf(0, triangle, 0.0, p, Vec3::Y, s.distance, cos_light);
+                assert!(
+                    (pdf / s.pdf - 1.0).abs() < 1e-4,
+                    "from {p} at {}: found with {pdf}, drawn with {}",
+                    s.point,
+                    s.pdf
+                );
+            }
+        }
+        assert!(halves.iter().all(|&h| h > 500), "{halves:?}");
+    }
 
     #[test]
     fn a_spot_lamp_with_a_radius_is_never_chosen_outside_its_cone() {

@@ -150,6 +150,7 @@ fn hit_barycentrics(p: DVec3, w: DVec3, [v0, v1, v2]: [DVec3; 3]) -> Option<Vec2
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::chi_square::upper_point;
     use crate::render::sampling::Rng;
 
     #[test]
@@ -232,7 +233,7 @@ mod tests {
             })
             .sum();
         let dof = (counts.len() - 1) as f64;
-        let limit = dof * (1.0 - 2.0 / (9.0 * dof) + 3.719 * (2.0 / (9.0 * dof)).sqrt()).powi(3);
+        let limit = upper_point(dof);
         assert!(chi < limit, "χ² {chi:.1} over the 99.99 % point {limit:.1}");
     }
 }

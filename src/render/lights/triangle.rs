@@ -1,12 +1,14 @@
 //! Emissive triangles as lights: each triangle of an emissive material, placed in world
 //! space (or placed at each path's time, for a moving instance), with its power, its bounds
 //! for the light tree, and a point drawn on it — uniform over the solid angle it subtends
-//! where that is well conditioned ([`spherical`]), else uniform over its area.
+//! where that is well conditioned ([`spherical`]), else uniform over its area. Pairs of a
+//! still, untextured mesh that make a rectangle are one light instead ([`quad`]).
 
 use std::collections::HashMap;
 
 use glam::{Affine3A, Vec2, Vec3};
 
+use super::quad::{Density, EmissiveQuad};
 use super::sample::LightSample;
 use super::spherical;
 use super::tree::{Cone, LightBounds, TreeInput};
@@ -34,21 +36,69 @@ struct EmissiveTriangle {
     texture: Option<(TextureRef, [Vec2; 3])>,
 }
 
+impl EmissiveTriangle {
+    /// The light sample at the point with barycentric weights `b` on `placed` (where this
+    /// triangle is), drawn from `p` with `density` by a light chosen with probability `pmf`.
+    fn sample_at(
+        &self,
+        scene: &Scene,
+        placed: &PlacedTriangle,
+        b: [f32; 3],
+        p: Vec3,
+        pmf: f32,
+        density: Density,
+    ) -> Option<LightSample> {
+        let (point, point_error) = interpolate_with_error(placed.corners, b);
+        let to_light = point - p;
+        let distance_sq = to_light.length_squared();
+        let distance = distance_sq.sqrt();
+        if distance == 0.0 {
+            return None;
+        }
+        let wi = to_light / distance;
+        let cos_light = placed.normal.dot(-wi);
+        if cos_light == 0.0 {
+            return None;
+        }
+        let mut radiance = if self.double_sided || cos_light > 0.0 {
+            self.radiance
+        } else {
+            Vec3::ZERO
+        };
+        if let Some((r, uvs)) = &self.texture {
+            let uv = b[0] * uvs[0] + b[1] * uvs[1] + b[2] * uvs[2];
+            radiance *= scene.textures[r.texture]
+                .sample(r, uv, ColorSpace::Srgb)
+                .truncate();
+        }
+        Some(LightSample {
+            point,
+            point_error,
+            normal: placed.normal,
+            wi,
+            distance,
+            radiance,
+            pdf: density.pdf(pmf, distance_sq, cos_light),
+            is_delta: false,
+        })
+    }
+}
+
 /// A triangle placed in world space.
 #[derive(Clone, Copy, Debug)]
-struct PlacedTriangle {
+pub struct PlacedTriangle {
     /// World-space corners with the rounding-error bound the transform added to each.
-    corners: [(Vec3, Vec3); 3],
+    pub corners: [(Vec3, Vec3); 3],
     /// Unit geometric normal, on the side the winding calls front.
-    normal: Vec3,
-    area: f32,
+    pub normal: Vec3,
+    pub area: f32,
 }
 
 impl PlacedTriangle {
     /// The object-space triangle `object` placed by `m`. Mirroring transforms flip the
     /// winding; the normal follows the object-space front face, which is what the
     /// renderer's hit normal uses too.
-    fn new(m: &Affine3A, object: [Vec3; 3]) -> PlacedTriangle {
+    pub fn new(m: &Affine3A, object: [Vec3; 3]) -> PlacedTriangle {
         let corners = transform_points_with_error(m, object);
         let [p0, p1, p2] = corners.map(|c| c.0);
         let cross = (p1 - p0).cross(p2 - p0);
@@ -77,10 +127,23 @@ impl PlacedTriangle {
     }
 }
 
+/// One light among the emissive triangles: a triangle alone or a rectangle of two.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Emitter {
+    /// A triangle, by index into the set's triangles.
+    Triangle(usize),
+    /// A rectangle, by index into the set's quads.
+    Quad(usize),
+}
+
 /// Every emissive triangle of a scene's instances, in instance order.
 #[derive(Clone, Debug, Default)]
 pub struct EmissiveTriangles {
     triangles: Vec<EmissiveTriangle>,
+    /// The pairs of triangles that are one rectangular light.
+    quads: Vec<EmissiveQuad>,
+    /// For each triangle, the quad it belongs to.
+    quad_of: Vec<Option<u32>>,
     /// For each instance, the index of its mesh's first triangle in `triangles`, if emissive.
     first_of_instance: Vec<Option<u32>>,
     /// The motions of moving emissive instances.
@@ -118,8 +181,61 @@ impl EmissiveTriangles {
                         .map(|r| (r, [a, b, c].map(|v| mesh.uv(r.texcoord, v as usize)))),
                 });
             }
+            let first = set.quad_of.len();
+            set.quad_of.resize(set.triangles.len(), None);
+            if motion.is_none() && inst.slice.is_none() && texture.is_none() {
+                set.pair_quads(first);
+            }
         }
         set
+    }
+
+    /// Makes quads of the rectangles that consecutive triangles from `first` on make.
+    fn pair_quads(&mut self, first: usize) {
+        let mut i = first;
+        while i + 1 < self.triangles.len() {
+            let placed = [&self.triangles[i].placed, &self.triangles[i + 1].placed];
+            match EmissiveQuad::pair([i, i + 1], placed) {
+                Some(quad) => {
+                    let index = Some(self.quads.len() as u32);
+                    (self.quad_of[i], self.quad_of[i + 1]) = (index, index);
+                    self.quads.push(quad);
+                    i += 2;
+                }
+                None => i += 1,
+            }
+        }
+    }
+
+    /// The lights the triangles make, in triangle order: each quad where its first
+    /// triangle is, and every triangle of no quad.
+    pub fn emitters(&self) -> Vec<Emitter> {
+        (0..self.triangles.len())
+            .filter_map(|i| match self.quad_of[i] {
+                None => Some(Emitter::Triangle(i)),
+                Some(q) if self.quads[q as usize].triangles[0] == i => {
+                    Some(Emitter::Quad(q as usize))
+                }
+                Some(_) => None,
+            })
+            .collect()
+    }
+
+    /// For each triangle, the index in `emitters` (as [`EmissiveTriangles::emitters`] gave
+    /// them) of the light it is part of.
+    pub fn emitter_indices(&self, emitters: &[Emitter]) -> Vec<u32> {
+        let mut index = vec![0; self.triangles.len()];
+        for (k, &e) in emitters.iter().enumerate() {
+            match e {
+                Emitter::Triangle(i) => index[i] = k as u32,
+                Emitter::Quad(q) => {
+                    for i in self.quads[q].triangles {
+                        index[i] = k as u32;
+                    }
+                }
+            }
+        }
+        index
     }
 
     /// Number of triangles.
@@ -132,9 +248,9 @@ impl EmissiveTriangles {
         self.triangles.is_empty()
     }
 
-    /// Emitted power (W, mean over channels) of every triangle, in order: area ×
-    /// exitance, a textured one's scaled by its texture's mean.
-    pub fn powers(&self, scene: &Scene) -> Vec<f32> {
+    /// Emitted power (W, mean over channels) of each of `emitters`: area × exitance, a
+    /// textured triangle's scaled by its texture's mean.
+    pub fn powers(&self, scene: &Scene, emitters: &[Emitter]) -> Vec<f32> {
         let mut texture_means = HashMap::new();
         let mut texture_mean = |r: TextureRef| {
             *texture_means.entry(r.texture).or_insert_with(|| {
@@ -142,20 +258,32 @@ impl EmissiveTriangles {
                 mean.truncate().element_sum() / 3.0
             })
         };
-        self.triangles
+        let mut power = |t: &EmissiveTriangle| {
+            let scale = t.texture.map_or(1.0, |(r, _)| texture_mean(r));
+            t.placed.area * t.exitance * scale
+        };
+        emitters
             .iter()
-            .map(|t| {
-                let scale = t.texture.map_or(1.0, |(r, _)| texture_mean(r));
-                t.placed.area * t.exitance * scale
+            .map(|&e| match e {
+                Emitter::Triangle(i) => power(&self.triangles[i]),
+                Emitter::Quad(q) => self.quads[q]
+                    .triangles
+                    .iter()
+                    .map(|&i| power(&self.triangles[i]))
+                    .sum(),
             })
             .collect()
     }
 
-    /// Where triangle `index` can send light from and to and how strongly, for the light
-    /// tree: a Lambertian emitter's intensity along its normal is radiance × area, and its
-    /// power π × radiance × area on each emitting side. A moving triangle is bounded over
-    /// the whole shutter, with any normal.
-    pub fn tree_input(&self, index: usize, power: f32) -> TreeInput {
+    /// Where `emitter` can send light from and to and how strongly, for the light tree: a
+    /// Lambertian emitter's intensity along its normal is radiance × area, and its power
+    /// π × radiance × area on each emitting side. A moving triangle is bounded over the
+    /// whole shutter, with any normal; a quad by its two triangles.
+    pub fn tree_input(&self, emitter: Emitter, power: f32) -> TreeInput {
+        let index = match emitter {
+            Emitter::Triangle(i) => i,
+            Emitter::Quad(q) => self.quads[q].triangles[0],
+        };
         let t = &self.triangles[index];
         let sides = if t.double_sided { 2.0 } else { 1.0 };
         let surface = |bounds, normals, two_sided| LightBounds {
@@ -165,6 +293,18 @@ impl EmissiveTriangles {
             cos_emission: 0.0,
             two_sided,
         };
+        if let Emitter::Quad(q) = emitter {
+            let [a, b] = self.quads[q].triangles.map(|i| self.triangles[i].placed);
+            let normals = Cone {
+                axis: a.normal,
+                cos_angle: a.normal.dot(b.normal).min(1.0),
+            };
+            return TreeInput::Placed(surface(
+                a.bounds().union(b.bounds()),
+                normals,
+                t.double_sided,
+            ));
+        }
         TreeInput::Placed(match t.moving {
             None => surface(
                 t.placed.bounds(),
@@ -187,70 +327,42 @@ impl EmissiveTriangles {
         })
     }
 
-    /// A point on triangle `index`, chosen with probability `pmf`, as seen from `p` at
-    /// shutter time `time`: uniform over the solid angle it subtends at `p` where that is
-    /// well conditioned, else uniform over its area, the density turned into solid angle by
+    /// A point on `emitter`, chosen with probability `pmf`, as seen from `p` at shutter
+    /// time `time`: uniform over the solid angle it subtends at `p` where that is well
+    /// conditioned, else uniform over its area, the density turned into solid angle by
     /// distance² / |cos θ_light|.
     pub fn sample(
         &self,
         scene: &Scene,
-        index: usize,
+        emitter: Emitter,
         pmf: f32,
         p: Vec3,
         time: f32,
         u: Vec2,
     ) -> Option<LightSample> {
+        let index = match emitter {
+            Emitter::Triangle(i) => i,
+            Emitter::Quad(q) => {
+                let quad = &self.quads[q];
+                let (half, weights, density) = quad.sample(p, u);
+                let tri = &self.triangles[quad.triangles[half]];
+                return tri.sample_at(scene, &tri.placed, weights, p, pmf, density);
+            }
+        };
         let tri = &self.triangles[index];
         let placed = self.placed_at(tri, time)?;
         if placed.area == 0.0 {
             return None;
         }
         let corners = placed.corners.map(|c| c.0);
-        let by_solid_angle = spherical::by_solid_angle(p, corners);
-        let b = match by_solid_angle {
-            Some((directions, omega)) => {
-                spherical::sample_from(p, corners, directions, omega, u)?.1
-            }
-            None => uniform_triangle(u),
+        let (b, density) = match spherical::by_solid_angle(p, corners) {
+            Some((directions, omega)) => (
+                spherical::sample_from(p, corners, directions, omega, u)?.1,
+                Density::SolidAngle(omega),
+            ),
+            None => (uniform_triangle(u), Density::Area(placed.area)),
         };
-        let (point, point_error) =
-            interpolate_with_error(placed.corners, [1.0 - b.x - b.y, b.x, b.y]);
-        let to_light = point - p;
-        let distance_sq = to_light.length_squared();
-        let distance = distance_sq.sqrt();
-        if distance == 0.0 {
-            return None;
-        }
-        let wi = to_light / distance;
-        let cos_light = placed.normal.dot(-wi);
-        if cos_light == 0.0 {
-            return None;
-        }
-        let pdf = match by_solid_angle {
-            Some((_, omega)) => pmf / omega as f32,
-            None => pmf / placed.area * distance_sq / cos_light.abs(),
-        };
-        let mut radiance = if tri.double_sided || cos_light > 0.0 {
-            tri.radiance
-        } else {
-            Vec3::ZERO
-        };
-        if let Some((r, uvs)) = &tri.texture {
-            let uv = (1.0 - b.x - b.y) * uvs[0] + b.x * uvs[1] + b.y * uvs[2];
-            radiance *= scene.textures[r.texture]
-                .sample(r, uv, ColorSpace::Srgb)
-                .truncate();
-        }
-        Some(LightSample {
-            point,
-            point_error,
-            normal: placed.normal,
-            wi,
-            distance,
-            radiance,
-            pdf,
-            is_delta: false,
-        })
+        tri.sample_at(scene, &placed, [1.0 - b.x - b.y, b.x, b.y], p, pmf, density)
     }
 
     /// The index of triangle `triangle` of instance `instance`, if that instance emits.
@@ -260,9 +372,10 @@ impl EmissiveTriangles {
     }
 
     /// The solid-angle density with which [`EmissiveTriangles::sample`] at `origin`, having
-    /// chosen triangle `index` with probability `pmf()`, would draw its point at `distance`
-    /// and light cosine `cos_light`, at shutter time `time`. `pmf` (a walk of the light
-    /// tree) is asked only when the triangle can have been sampled at all.
+    /// chosen the light of triangle `index` ([`EmissiveTriangles::emitter_of`]) with
+    /// probability `pmf()`, would draw its point at `distance` and light cosine `cos_light`,
+    /// at shutter time `time`. `pmf` (a walk of the light tree) is asked only when the
+    /// triangle can have been sampled at all.
     pub fn pdf(
         &self,
         index: usize,
@@ -282,10 +395,14 @@ impl EmissiveTriangles {
         if pmf == 0.0 {
             return 0.0;
         }
-        if let Some((_, omega)) = spherical::by_solid_angle(origin, placed.corners.map(|c| c.0)) {
-            return pmf / omega as f32;
-        }
-        pmf / placed.area * distance * distance / cos_light.abs()
+        let density = match self.quad_of[index] {
+            Some(q) => self.quads[q as usize].density(origin),
+            None => match spherical::by_solid_angle(origin, placed.corners.map(|c| c.0)) {
+                Some((_, omega)) => Density::SolidAngle(omega),
+                None => Density::Area(placed.area),
+            },
+        };
+        density.pdf(pmf, distance * distance, cos_light)
     }
 
     /// Where `tri` is at shutter time `time`, or `None` when it is not there then (a time
