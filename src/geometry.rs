@@ -2,7 +2,7 @@
 //! rounding error (Higham 2002; pbrt-v4 §6.8) that let rays leave surfaces and cross slabs
 //! without an epsilon, and which triangles are too degenerate ever to be hit.
 
-use glam::{Affine3A, Mat3, Vec3};
+use glam::{Affine3A, Mat3A, Vec3, Vec3A};
 
 /// An axis-aligned bounding box.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,17 +89,19 @@ pub fn transform_points_with_error<const N: usize>(
     m: &Affine3A,
     points: [Vec3; N],
 ) -> [(Vec3, Vec3); N] {
-    let abs = Mat3::from_cols(
-        m.matrix3.x_axis.abs().into(),
-        m.matrix3.y_axis.abs().into(),
-        m.matrix3.z_axis.abs().into(),
+    // In SIMD lanes (`Mat3A`, `Vec3A`): the same operations in the same order as in `Vec3`.
+    let abs = Mat3A::from_cols(
+        m.matrix3.x_axis.abs(),
+        m.matrix3.y_axis.abs(),
+        m.matrix3.z_axis.abs(),
     );
-    let translation = Vec3::from(m.translation).abs();
+    let translation = m.translation.abs();
     let mut placed = [(Vec3::ZERO, Vec3::ZERO); N];
     for (out, p) in placed.iter_mut().zip(points) {
+        let p = Vec3A::from(p);
         *out = (
-            m.transform_point3(p),
-            gamma(3) * (abs * p.abs() + translation),
+            m.transform_point3a(p).into(),
+            (gamma(3) * (abs * p.abs() + translation)).into(),
         );
     }
     placed
@@ -108,13 +110,14 @@ pub fn transform_points_with_error<const N: usize>(
 /// Interpolates three corners (with their error bounds) at barycentrics (b0, b1, b2), and
 /// bounds the result's error (pbrt-v4 §6.8.4: γ(7)·Σ|bᵢpᵢ|, plus the corners' own error).
 pub fn interpolate_with_error(corners: [(Vec3, Vec3); 3], b: [f32; 3]) -> (Vec3, Vec3) {
-    let mut point = Vec3::ZERO;
-    let mut error = Vec3::ZERO;
+    let mut point = Vec3A::ZERO;
+    let mut error = Vec3A::ZERO;
     for ((p, e), w) in corners.into_iter().zip(b) {
+        let (p, e) = (Vec3A::from(p), Vec3A::from(e));
         point += w * p;
         error += (w * p).abs() * gamma(7) + w.abs() * e;
     }
-    (point, error)
+    (point.into(), error.into())
 }
 
 /// A ray origin moved off a surface just far enough that the rounding error of `p` cannot
