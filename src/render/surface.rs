@@ -1,7 +1,7 @@
 //! What the renderer needs to know about a hit point: position with its rounding-error
 //! bound, normals, material; and how to start new rays from it without hitting it again.
 
-use glam::{Affine3A, Mat3, Vec3};
+use glam::{Affine3A, Mat3, Mat3A, Vec3, Vec3A};
 
 use crate::accel::SceneHit;
 use crate::geometry::{interpolate_with_error, transform_points_with_error};
@@ -34,8 +34,8 @@ pub struct Surface {
 #[derive(Clone, Copy, Debug)]
 pub struct InstanceFrame {
     pub(super) world_from_object: Affine3A,
-    /// Inverse transpose of the linear part: normals transform by it.
-    normal_matrix: Mat3,
+    /// Inverse transpose of the linear part: normals transform by it (in SIMD lanes).
+    normal_matrix: Mat3A,
 }
 
 impl InstanceFrame {
@@ -43,7 +43,7 @@ impl InstanceFrame {
     pub fn new(world_from_object: Affine3A) -> InstanceFrame {
         InstanceFrame {
             world_from_object,
-            normal_matrix: Mat3::from(world_from_object.matrix3).inverse().transpose(),
+            normal_matrix: Mat3A::from(Mat3::from(world_from_object.matrix3).inverse().transpose()),
         }
     }
 
@@ -74,14 +74,17 @@ pub fn surface_at(scene: &Scene, frames: &[InstanceFrame], hit: &SceneHit) -> Su
     let p = [a, b, c].map(|i| mesh.positions[i]);
     // The object-space face normal through the normal matrix keeps the file's notion of
     // front even under mirroring transforms.
-    let geometric = (frame.normal_matrix * (p[1] - p[0]).cross(p[2] - p[0])).normalize_or_zero();
+    // (`Vec3A`: the same operations as `Vec3` in SIMD lanes.)
+    let [p0, p1, p2] = p.map(Vec3A::from);
+    let geometric = (frame.normal_matrix * (p1 - p0).cross(p2 - p0)).normalize_or_zero();
     let w = 1.0 - hit.u - hit.v;
     let corners = transform_points_with_error(&frame.world_from_object, p);
     let (point, point_error) = interpolate_with_error(corners, [w, hit.u, hit.v]);
     let shading = if mesh.normals.is_empty() {
         geometric
     } else {
-        let interpolated = w * mesh.normals[a] + hit.u * mesh.normals[b] + hit.v * mesh.normals[c];
+        let [na, nb, nc] = [a, b, c].map(|i| Vec3A::from(mesh.normals[i]));
+        let interpolated = w * na + hit.u * nb + hit.v * nc;
         (frame.normal_matrix * interpolated)
             .try_normalize()
             .unwrap_or(geometric)
@@ -89,8 +92,8 @@ pub fn surface_at(scene: &Scene, frames: &[InstanceFrame], hit: &SceneHit) -> Su
     Surface {
         point,
         point_error,
-        geometric_normal: geometric,
-        shading_normal: shading,
+        geometric_normal: geometric.into(),
+        shading_normal: shading.into(),
         material: mesh.material,
         instance: hit.instance as usize,
         vertices: [a, b, c],
