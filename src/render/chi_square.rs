@@ -56,6 +56,21 @@ pub fn sphere_z_score(
     (z, chi2, dof)
 }
 
+/// χ² of `counts` against expected counts in proportion to `weights` (each bin's share of
+/// the whole, up to a common factor), for as many samples as `counts` holds.
+pub fn against_weights(counts: &[u64], weights: &[f64]) -> f64 {
+    let samples: u64 = counts.iter().sum();
+    let whole: f64 = weights.iter().sum();
+    counts
+        .iter()
+        .zip(weights)
+        .map(|(&c, &w)| {
+            let e = w / whole * samples as f64;
+            (c as f64 - e).powi(2) / e
+        })
+        .sum()
+}
+
 /// The value a χ² statistic with `dof` degrees of freedom exceeds with probability 10⁻⁴
 /// (z = 3.719 through Wilson–Hilferty): the limit of tests with equal or known bin shares.
 pub fn upper_point(dof: f64) -> f64 {

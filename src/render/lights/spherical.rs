@@ -150,7 +150,7 @@ fn hit_barycentrics(p: DVec3, w: DVec3, [v0, v1, v2]: [DVec3; 3]) -> Option<Vec2
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::chi_square::upper_point;
+    use crate::render::chi_square::{against_weights, upper_point};
     use crate::render::sampling::Rng;
 
     #[test]
@@ -224,14 +224,7 @@ mod tests {
             };
             counts[cell_of[&key]] += 1;
         }
-        let chi: f64 = counts
-            .iter()
-            .zip(&expected)
-            .map(|(&c, &e)| {
-                let e = e / total * samples as f64;
-                (c as f64 - e).powi(2) / e
-            })
-            .sum();
+        let chi = against_weights(&counts, &expected);
         let dof = (counts.len() - 1) as f64;
         let limit = upper_point(dof);
         assert!(chi < limit, "χ² {chi:.1} over the 99.99 % point {limit:.1}");

@@ -136,7 +136,7 @@ impl SphericalRectangle {
 mod tests {
     use super::super::spherical::solid_angle;
     use super::*;
-    use crate::render::chi_square::upper_point;
+    use crate::render::chi_square::{against_weights, upper_point};
     use crate::render::sampling::Rng;
 
     /// The solid angle of the rectangle as two spherical triangles (Van Oosterom &
@@ -214,14 +214,7 @@ mod tests {
                 );
                 counts[j * n + i] += 1;
             }
-            let chi: f64 = counts
-                .iter()
-                .zip(&expected)
-                .map(|(&c, &e)| {
-                    let e = e / covered * samples as f64;
-                    (c as f64 - e).powi(2) / e
-                })
-                .sum();
+            let chi = against_weights(&counts, &expected);
             let limit = upper_point((counts.len() - 1) as f64);
             assert!(
                 chi < limit,
