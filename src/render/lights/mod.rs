@@ -342,7 +342,7 @@ mod tests {
                 assert!((s.point.y - 2.0).abs() < 1e-5 && s.point.x.abs() <= 0.5 + 1e-5);
                 assert!(s.point.z.abs() <= 0.3 + 1e-5, "{}", s.point);
                 // Which triangle the point is on: the diagonal from (-0.5, -0.3) to (0.5, 0.3).
-                let triangle = u32::from(s.point.z * 1.0 < s.point.x * 0.6);
+                let triangle = u32::from(s.point.z < s.point.x * 0.6);
                 halves[triangle as usize] += 1;
                 let cos_light = s.normal.dot(-s.wi);
                 let pdf = set.pdf(0, triangle, 0.0, p, Vec3::Y, s.distance, cos_light);

@@ -48,8 +48,8 @@ enum Rule {
 
 impl EmissiveQuad {
     /// The rectangle triangles `indices` (placed as `placed`) make, if they make one: they
-    /// share exactly two corners, face the same way, and the first has a right angle at its
-    /// third corner whose mirror image over the shared diagonal is the second's.
+    /// share exactly two corners and face the same way, the first has a right angle at the
+    /// corner it does not share, and the second's own corner closes the rectangle.
     pub fn pair(indices: [usize; 2], placed: [&PlacedTriangle; 2]) -> Option<EmissiveQuad> {
         let [first, second] = placed.map(|t| t.corners.map(|c| c.0));
         if placed[0].area == 0.0 || placed[1].area == 0.0 {
