@@ -152,14 +152,14 @@ mod tests {
         PlacedTriangle::new(&Affine3A::IDENTITY, corners)
     }
 
+    /// The corners of a 2 × 1 rectangle in the plane z = `z`, in order around it.
+    fn rectangle(z: f32) -> [Vec3; 4] {
+        [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (0.0, 1.0)].map(|(x, y)| Vec3::new(x, y, z))
+    }
+
     #[test]
     fn two_halves_of_a_rectangle_pair_and_other_shapes_do_not() {
-        let [a, b, c, d] = [
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(2.0, 0.0, 0.0),
-            Vec3::new(2.0, 1.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-        ];
+        let [a, b, c, d] = rectangle(0.0);
         // Both windings of the diagonal, corners in any rotation.
         for (first, second) in [
             ([a, b, c], [a, c, d]),
@@ -190,12 +190,7 @@ mod tests {
 
     #[test]
     fn samples_land_on_the_rectangle_where_its_coordinates_say() {
-        let [a, b, c, d] = [
-            Vec3::new(0.0, 0.0, 1.0),
-            Vec3::new(2.0, 0.0, 1.0),
-            Vec3::new(2.0, 1.0, 1.0),
-            Vec3::new(0.0, 1.0, 1.0),
-        ];
+        let [a, b, c, d] = rectangle(1.0);
         let halves = [[b, c, a], [c, d, a]];
         let quad =
             EmissiveQuad::pair([0, 1], halves.each_ref().map(|&t| placed(t)).each_ref()).unwrap();
