@@ -231,7 +231,9 @@ pub struct LightTree {
     /// Where each light at infinity is in `infinite`.
     infinite_slot: Vec<Option<usize>>,
     /// The one light there is, when there is one with a place and none at infinity (a
-    /// room lit by one lamp): chosen whenever it can bring anything, with no walk.
+    /// room lit by one lamp): chosen everywhere with probability 1, with no walk and no
+    /// importance. Where it can bring nothing (a spot's outside, a lamp's back) its own
+    /// sample says so; MIS stays consistent because `pmf` says 1 wherever `choose` does.
     alone: Option<usize>,
 }
 
@@ -342,13 +344,6 @@ impl LightTree {
         index
     }
 
-    /// The importance of the only light ([`LightTree::alone`]), or 0 when it is not finite:
-    /// what the walk would find, without it.
-    fn alone_weight(&self, p: Vec3, n: Vec3) -> f32 {
-        let w = self.leaf_lights[0].1.importance(p, n);
-        if w.is_finite() { w } else { 0.0 }
-    }
-
     /// The lights of leaf `node`.
     fn leaf(&self, node: &Node) -> &[(usize, Reach)] {
         &self.leaf_lights[node.index as usize..(node.index + node.count) as usize]
@@ -383,7 +378,7 @@ impl LightTree {
     /// with; `u` in [0, 1).
     pub fn choose(&self, p: Vec3, n: Vec3, u: f32) -> Option<(usize, f32)> {
         if let Some(light) = self.alone {
-            return (self.alone_weight(p, n) > 0.0).then_some((light, 1.0));
+            return Some((light, 1.0));
         }
         let (tree, total, root_weights) = self.tree_weight(p, n);
         if !(total > 0.0 && total.is_finite()) {
@@ -437,8 +432,7 @@ impl LightTree {
     /// normal `n`.
     pub fn pmf(&self, light: usize, p: Vec3, n: Vec3) -> f32 {
         if let Some(alone) = self.alone {
-            let chosen = alone == light && self.alone_weight(p, n) > 0.0;
-            return if chosen { 1.0 } else { 0.0 };
+            return if alone == light { 1.0 } else { 0.0 };
         }
         let (tree, total, root_weights) = self.tree_weight(p, n);
         if !(total > 0.0 && total.is_finite()) {
@@ -601,22 +595,23 @@ mod tests {
     }
 
     #[test]
-    fn a_lone_light_is_chosen_wherever_it_can_bring_light() {
+    fn a_lone_light_is_chosen_everywhere() {
         // A lone spot, beside a light that brings nothing: chosen with probability 1 inside
-        // its cone, never outside, and never anything else; with a sun beside it the walk
-        // (and the sun) decide again.
+        // its cone and outside it (where its own sample brings nothing), never anything
+        // else, `pmf` agreeing with `choose`; with a sun beside it the walk (and the sun)
+        // decide again.
         let spot = spot_down(Vec3::Y, 100.0, 30.0);
         let dark = point_light(Vec3::new(5.0, 1.0, 0.0), 0.0);
         let tree = LightTree::build(&[dark, spot]);
         assert_eq!(tree.alone, Some(1));
         let (inside, outside) = (Vec3::new(0.3, 0.0, 0.0), Vec3::new(2.0, 0.0, 0.0));
-        for u in [0.0, 0.5, 0.999] {
-            assert_eq!(tree.choose(inside, Vec3::Y, u), Some((1, 1.0)));
-            assert_eq!(tree.choose(outside, Vec3::Y, u), None);
+        for p in [inside, outside] {
+            for u in [0.0, 0.5, 0.999] {
+                assert_eq!(tree.choose(p, Vec3::Y, u), Some((1, 1.0)));
+            }
+            assert_eq!(tree.pmf(1, p, Vec3::Y), 1.0);
+            assert_eq!(tree.pmf(0, p, Vec3::Y), 0.0);
         }
-        assert_eq!(tree.pmf(1, inside, Vec3::Y), 1.0);
-        assert_eq!(tree.pmf(0, inside, Vec3::Y), 0.0);
-        assert_eq!(tree.pmf(1, outside, Vec3::Y), 0.0);
         let sun = TreeInput::Infinite(Distant {
             irradiance: 0.5,
             towards: Some(Vec3::Y),
