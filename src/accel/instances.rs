@@ -67,6 +67,9 @@ struct Entry {
     /// World-from-object over the shutter, when it moves.
     motion: Option<Motion>,
     slice: Option<TimeSlice>,
+    /// The grid has one cell ([`Grid::is_one_cell`]): its blocks are tested in the top
+    /// level's own code.
+    one_cell: bool,
 }
 
 impl Entry {
@@ -172,6 +175,7 @@ impl SceneAccel {
                                 world_bounds: instance_bounds(scene, inst),
                                 motion: inst.motion.clone(),
                                 slice: inst.slice,
+                                one_cell: grids[grid].is_one_cell(),
                             });
                         }
                     }
@@ -183,6 +187,7 @@ impl SceneAccel {
                     world_bounds: instance_bounds(scene, &scene.instances[*i]),
                     motion: None,
                     slice: scene.instances[*i].slice,
+                    one_cell: grids[grid].is_one_cell(),
                 }),
             }
         }
@@ -275,9 +280,10 @@ impl SceneAccel {
                         continue;
                     }
                     let entry = &self.entries[e];
-                    if let Some(hit) = entry.in_grid_space(ray).and_then(|local| {
-                        self.grids[entry.grid].intersect_counting(&local.with_t_max(t_max), stats)
-                    }) {
+                    if let Some(hit) = entry
+                        .in_grid_space(ray)
+                        .and_then(|local| self.nearest_in(entry, &local.with_t_max(t_max), stats))
+                    {
                         t_max = hit.t;
                         best = Some((e as u32, hit));
                     }
@@ -359,9 +365,10 @@ impl SceneAccel {
                 while met != 0 {
                     let entry = &self.entries[met.trailing_zeros() as usize];
                     met &= met - 1;
-                    if entry.in_grid_space(ray).is_some_and(|local| {
-                        self.grids[entry.grid].occluded_counting(&local, stats)
-                    }) {
+                    if entry
+                        .in_grid_space(ray)
+                        .is_some_and(|local| self.blocked_in(entry, &local, stats))
+                    {
                         return true;
                     }
                 }
@@ -398,7 +405,36 @@ impl SceneAccel {
         stats.test_instance();
         let entry = &self.entries[e];
         let local = entry.local_ray(ray, inv_direction, t_max)?;
-        self.grids[entry.grid].intersect_counting(&local.with_t_max(t_max), stats)
+        self.nearest_in(entry, &local.with_t_max(t_max), stats)
+    }
+
+    /// The nearest hit in `entry`'s grid along `ray`, already in the grid's space: a grid
+    /// of one cell tested here ([`Grid::intersect_one_cell`]), any other walked.
+    #[inline(always)]
+    fn nearest_in(
+        &self,
+        entry: &Entry,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> Option<GridHit> {
+        let grid = &self.grids[entry.grid];
+        if entry.one_cell {
+            grid.intersect_one_cell(ray, stats)
+        } else {
+            grid.intersect_counting(ray, stats)
+        }
+    }
+
+    /// True when `entry`'s grid blocks `ray`, already in the grid's space, as
+    /// [`SceneAccel::nearest_in`] asks it.
+    #[inline(always)]
+    fn blocked_in(&self, entry: &Entry, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        let grid = &self.grids[entry.grid];
+        if entry.one_cell {
+            grid.occluded_one_cell(ray, stats)
+        } else {
+            grid.occluded_counting(ray, stats)
+        }
     }
 
     /// `query` asked of the grid of a scene's one entry ([`SceneAccel::is_one_entry`]) for
@@ -434,7 +470,7 @@ impl SceneAccel {
         let entry = &self.entries[e];
         entry
             .local_ray(ray, inv_direction, ray.t_max)
-            .is_some_and(|local| self.grids[entry.grid].occluded_counting(&local, stats))
+            .is_some_and(|local| self.blocked_in(entry, &local, stats))
     }
 }
 

@@ -78,6 +78,50 @@ impl Grid {
         nearest
     }
 
+    /// True for a grid of one occupied cell without block boxes (a wall, a lamp, a cube: a
+    /// mesh of a few triangles), which [`Grid::intersect_one_cell`] and
+    /// [`Grid::occluded_one_cell`] answer without a walk.
+    pub(crate) fn is_one_cell(&self) -> bool {
+        self.frame.resolution == UVec3::ONE
+            && !self.blocks.is_empty()
+            && self.block_boxes.is_empty()
+    }
+
+    /// [`Grid::intersect_counting`] for a grid of one cell ([`Grid::is_one_cell`]): the
+    /// same blocks tested in the same order, so the same hit, but inlined into the caller
+    /// (the top level, already compiled for the processor's instruction set) rather than
+    /// dispatched: for a scene of walls and lamps the dispatch and the walk's setup cost
+    /// more than the triangles.
+    #[inline(always)]
+    pub(crate) fn intersect_one_cell(
+        &self,
+        ray: &Ray,
+        stats: &mut impl TraversalStats,
+    ) -> Option<GridHit> {
+        stats.visit_occupied();
+        let mut nearest: Option<GridHit> = None;
+        let mut t_nearest = ray.t_max;
+        for block in &self.blocks {
+            stats.test_triangles(block.len());
+            if let Some(hit) = block.nearest(ray, t_nearest) {
+                t_nearest = hit.t;
+                nearest = Some(hit.into());
+            }
+        }
+        nearest
+    }
+
+    /// [`Grid::occluded_counting`] for a grid of one cell ([`Grid::is_one_cell`]), inlined
+    /// as [`Grid::intersect_one_cell`] is.
+    #[inline(always)]
+    pub(crate) fn occluded_one_cell(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
+        stats.visit_occupied();
+        self.blocks.iter().any(|block| {
+            stats.test_triangles(block.len());
+            block.any(ray, ray.t_max)
+        })
+    }
+
     /// Walks `ray` through the grid as [`Grid::intersect`] does when the nearest hit lies
     /// at `t_stop` (∞ for none) — the same steps, the look-ahead to the next occupied cell
     /// included — without reading or testing any triangle; returns the number of occupied
@@ -265,6 +309,65 @@ mod tests {
                 [Triangle::new(a, b, c), Triangle::new(a, c, d)]
             })
             .collect()
+    }
+
+    /// A grid of one cell answers in the top level's inlined form what its query and every
+    /// triangle tested in turn answer: meshes of a few random triangles (a wall, a lamp, a
+    /// box), rays from inside and outside, shadow segments ending before, at and past the
+    /// nearest hit.
+    #[test]
+    fn a_grid_of_one_cell_answers_inline_what_its_query_answers() {
+        let mut rng = crate::render::sampling::Rng::new(43, 5);
+        let (mut one_cell, mut hits) = (0, 0);
+        for mesh in 0..200 {
+            let mut u = || rng.uniform() * 2.0 - 1.0;
+            let triangles: Vec<Triangle> = (0..1 + mesh % 12)
+                .map(|_| {
+                    let a = Vec3::new(u(), u(), u());
+                    Triangle::new(
+                        a,
+                        a + Vec3::new(u(), u(), u()),
+                        a + Vec3::new(u(), u(), u()),
+                    )
+                })
+                .collect();
+            let grid = Grid::build(triangles.clone());
+            if !grid.is_one_cell() {
+                continue;
+            }
+            one_cell += 1;
+            for k in 0..100 {
+                let origin = Vec3::new(u(), u(), u()) * if k % 2 == 0 { 1.0 } else { 4.0 };
+                let mut ray = Ray::new(origin, (Vec3::new(u(), u(), u()) - origin).normalize());
+                let nearest = triangles.iter().enumerate().fold(
+                    None,
+                    |best: Option<(f32, usize)>, (i, t)| match t
+                        .intersect(&ray, best.map_or(ray.t_max, |b| b.0))
+                    {
+                        Some(hit) => Some((hit.t, i)),
+                        None => best,
+                    },
+                );
+                let inline = grid.intersect_one_cell(&ray, &mut ());
+                assert_eq!(inline, grid.intersect(&ray), "mesh {mesh}, ray {k}");
+                assert_eq!(inline.map(|h| (h.t, h.triangle as usize)), nearest);
+                hits += usize::from(nearest.is_some());
+                for end in [0.999, 1.0, 1.001] {
+                    ray.t_max = nearest.map_or(8.0, |n| n.0 * end);
+                    let blocked = grid.occluded_one_cell(&ray, &mut ());
+                    assert_eq!(blocked, grid.occluded(&ray), "mesh {mesh}, ray {k}");
+                    assert_eq!(
+                        blocked,
+                        nearest.is_some() && end > 1.0,
+                        "mesh {mesh}, ray {k}"
+                    );
+                }
+            }
+        }
+        assert!(
+            one_cell > 50 && hits > 2_000,
+            "{one_cell} meshes, {hits} hits"
+        );
     }
 
     /// Every kind of step is counted where the walk takes it: a step of the cell count is
