@@ -116,10 +116,15 @@ impl Grid {
     #[inline(always)]
     pub(crate) fn occluded_one_cell(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         stats.visit_occupied();
-        self.blocks.iter().any(|block| {
+        // A loop rather than `Iterator::any`, whose closure was compiled out of line, for
+        // the baseline instruction set.
+        for block in &self.blocks {
             stats.test_triangles(block.len());
-            block.any(ray, ray.t_max)
-        })
+            if block.any(ray, ray.t_max) {
+                return true;
+            }
+        }
+        false
     }
 
     /// Walks `ray` through the grid as [`Grid::intersect`] does when the nearest hit lies
