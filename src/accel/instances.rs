@@ -90,9 +90,19 @@ impl Entry {
     }
 
     /// The ray in the grid's space, or `None` when the entry is not there at its time (its
-    /// bounds already known to be met).
-    #[inline]
+    /// bounds already known to be met). The common case, a grid that takes world rays,
+    /// inline; the others out of line.
+    #[inline(always)]
     fn in_grid_space(&self, ray: &Ray) -> Option<Ray> {
+        if self.takes_world_rays() {
+            return Some(*ray);
+        }
+        self.moved_into_grid_space(ray)
+    }
+
+    /// [`Entry::in_grid_space`] for a grid in object space, moving, or in a time slice.
+    #[inline(never)]
+    fn moved_into_grid_space(&self, ray: &Ray) -> Option<Ray> {
         if self.slice.as_ref().is_some_and(|s| !s.contains(ray.time)) {
             return None;
         }
