@@ -294,6 +294,17 @@ mod tests {
         assert_eq!(portable, blocked, "ray {k}");
     }
 
+    /// The nearest hit along `ray` (parameter and index) found by testing every triangle in
+    /// turn: what a grid's query must find.
+    fn nearest_of_every(triangles: &[Triangle], ray: &Ray) -> Option<(f32, usize)> {
+        triangles.iter().enumerate().fold(None, |best, (i, t)| {
+            match t.intersect(ray, best.map_or(ray.t_max, |b: (f32, usize)| b.0)) {
+                Some(hit) => Some((hit.t, i)),
+                None => best,
+            }
+        })
+    }
+
     /// A sphere of radius 1 at the origin, `n` × 2`n` quads split in two.
     fn sphere(n: usize) -> Vec<Triangle> {
         let at = |i: usize, j: usize| {
@@ -344,15 +355,7 @@ mod tests {
             for k in 0..100 {
                 let origin = Vec3::new(u(), u(), u()) * if k % 2 == 0 { 1.0 } else { 4.0 };
                 let mut ray = Ray::new(origin, (Vec3::new(u(), u(), u()) - origin).normalize());
-                let nearest = triangles.iter().enumerate().fold(
-                    None,
-                    |best: Option<(f32, usize)>, (i, t)| match t
-                        .intersect(&ray, best.map_or(ray.t_max, |b| b.0))
-                    {
-                        Some(hit) => Some((hit.t, i)),
-                        None => best,
-                    },
-                );
+                let nearest = nearest_of_every(&triangles, &ray);
                 let inline = grid.intersect_one_cell(&ray, &mut ());
                 assert_eq!(inline, grid.intersect(&ray), "mesh {mesh}, ray {k}");
                 assert_eq!(inline.map(|h| (h.t, h.triangle as usize)), nearest);
@@ -423,15 +426,7 @@ mod tests {
             // Aimed near the sphere's rim, so many rays pass occupied cells before a hit.
             let target = Vec3::new(u(), u(), u()) * 1.05;
             let mut ray = Ray::new(origin, (target - origin).normalize());
-            let nearest = triangles.iter().enumerate().fold(
-                None,
-                |best: Option<(f32, usize)>, (i, t)| match t
-                    .intersect(&ray, best.map_or(ray.t_max, |b| b.0))
-                {
-                    Some(hit) => Some((hit.t, i)),
-                    None => best,
-                },
-            );
+            let nearest = nearest_of_every(&triangles, &ray);
             let found = grid.intersect_counting(&ray, &mut counts);
             assert_eq!(
                 found.map(|h| (h.t, h.triangle as usize)),
