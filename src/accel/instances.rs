@@ -17,10 +17,13 @@ use rayon::prelude::*;
 use super::box_lanes::{BoxLanes, hits_box};
 #[cfg(target_arch = "x86_64")]
 use super::isa::{Kernel, X86Level, dispatch};
+use super::placement::{
+    GridSource, Placement, build_grid, grid_sources, instance_bounds, placements,
+};
 use super::top_level::{InstanceGrid, Mailbox};
 use super::{Grid, GridHit, Ray, TraversalStats};
 use crate::geometry::Aabb;
-use crate::scene::{Instance, Motion, Scene, TimeSlice};
+use crate::scene::{Motion, Scene, TimeSlice};
 
 /// Up to this many entries are tested one after another; past it, the instance grid
 /// visits only those near the ray (`cargo bench --bench instances`: at 11 instances the
@@ -128,23 +131,6 @@ fn nearest_of(set: u32, start: &[f32]) -> usize {
         }
     }
     nearest
-}
-
-/// How the build places one scene instance.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Placement {
-    /// Its mesh's grid in object space, shared with the mesh's other instances.
-    Object,
-    /// A grid of its own in world space.
-    World,
-}
-
-/// What one grid is built over.
-enum GridSource {
-    /// A mesh in object space, for all its instances placed there.
-    Mesh(usize),
-    /// One instance's mesh in world space.
-    Instance(usize),
 }
 
 /// Ray queries over a whole scene.
@@ -481,90 +467,6 @@ impl SceneAccel {
         entry
             .local_ray(ray, inv_direction, ray.t_max)
             .is_some_and(|local| self.blocked_in(entry, &local, stats))
-    }
-}
-
-/// How each scene instance is placed: meshes used more than once, and moving instances,
-/// stay in object space; a mesh placed once gets a world-space grid of its own.
-fn placements(scene: &Scene) -> Vec<Placement> {
-    let mut uses = vec![0usize; scene.meshes.len()];
-    for inst in &scene.instances {
-        uses[inst.mesh] += 1;
-    }
-    scene
-        .instances
-        .iter()
-        .map(|inst| {
-            if uses[inst.mesh] > 1 || inst.motion.is_some() {
-                Placement::Object
-            } else {
-                Placement::World
-            }
-        })
-        .collect()
-}
-
-/// The grids to build, in a fixed order: object-space meshes, then world-space instances.
-fn grid_sources(scene: &Scene, placement: &[Placement]) -> Vec<GridSource> {
-    let mut sources: Vec<GridSource> = (0..scene.meshes.len())
-        .filter(|&mesh| {
-            (scene.instances.iter().zip(placement))
-                .any(|(inst, &p)| inst.mesh == mesh && p == Placement::Object)
-        })
-        .map(GridSource::Mesh)
-        .collect();
-    sources.extend(
-        (0..scene.instances.len())
-            .filter(|&i| placement[i] == Placement::World)
-            .map(GridSource::Instance),
-    );
-    sources
-}
-
-/// Builds the grid of one source.
-fn build_grid(scene: &Scene, source: &GridSource) -> Grid {
-    let world_positions = |inst: &Instance| -> Vec<Vec3> {
-        let m = inst.world_from_object;
-        let positions = &scene.meshes[inst.mesh].positions;
-        positions.iter().map(|&p| m.transform_point3(p)).collect()
-    };
-    match source {
-        GridSource::Mesh(mesh) => {
-            let m = &scene.meshes[*mesh];
-            Grid::from_mesh(m.positions.clone(), &m.indices)
-        }
-        GridSource::Instance(i) => {
-            let inst = &scene.instances[*i];
-            Grid::from_mesh(world_positions(inst), &scene.meshes[inst.mesh].indices)
-        }
-    }
-}
-
-/// World bounds of an instance over the whole shutter.
-fn instance_bounds(scene: &Scene, inst: &Instance) -> Aabb {
-    let object = scene.meshes[inst.mesh].bounds();
-    match &inst.motion {
-        None => culling_bounds(&object, &inst.world_from_object),
-        Some(motion) => motion
-            .keys()
-            .iter()
-            .fold(Aabb::EMPTY, |b, key| b.union(culling_bounds(&object, key))),
-    }
-}
-
-/// World bounds for culling rays against an instance: the mesh's own bounds, transformed,
-/// grown by a few ulps of their coordinates to cover rounding. Not the grid's bounds: those
-/// are padded by a fraction of the mesh's size, and a ray leaving a flat mesh (a wall)
-/// starts inside that padding, so it would walk the wall's grid for nothing.
-fn culling_bounds(object: &Aabb, world_from_object: &Affine3A) -> Aabb {
-    let b = object.transformed(world_from_object);
-    if b.is_empty() {
-        return b;
-    }
-    let pad = Vec3::splat(2.0 * f32::EPSILON * b.min.abs().max(b.max.abs()).max_element());
-    Aabb {
-        min: b.min - pad,
-        max: b.max + pad,
     }
 }
 

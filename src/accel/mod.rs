@@ -6,6 +6,7 @@ mod grid;
 mod huge_pages;
 mod instances;
 mod isa;
+mod placement;
 mod ray;
 mod top_level;
 mod triangle;
