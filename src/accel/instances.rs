@@ -15,7 +15,6 @@ use glam::{Affine3A, Vec3};
 use rayon::prelude::*;
 
 use super::box_lanes::{BoxLanes, hits_box};
-use super::convex::{ConvexSides, Leaving, convex_sides};
 #[cfg(target_arch = "x86_64")]
 use super::isa::{Kernel, X86Level, dispatch};
 use super::placement::{
@@ -118,12 +117,6 @@ impl Entry {
     }
 }
 
-/// The bit of entry `skip` in a set of entries (none for [`NO_ENTRY`] or past the set).
-#[inline(always)]
-fn skip_bit(skip: u32) -> u32 {
-    1u32.checked_shl(skip).unwrap_or(0)
-}
-
 /// The box among `set` (box `i` in bit `i`, at least one) whose entry distance in `start`
 /// is least; the lowest index among equals.
 #[inline(always)]
@@ -148,13 +141,7 @@ pub struct SceneAccel {
     instance_grid: Option<InstanceGrid>,
     /// A list's bounds, tested against each ray all at once (up to [`LIST_MAX`] entries).
     list_bounds: Option<Box<BoxLanes>>,
-    /// Per scene instance: its entry and the sides from which a ray leaves it for good
-    /// ([`super::convex`]).
-    left_behind: Vec<(u32, ConvexSides)>,
 }
-
-/// No entry: a ray that leaves no surface, or one that may meet it again.
-const NO_ENTRY: u32 = u32::MAX;
 
 impl SceneAccel {
     /// Builds the grids (in parallel) and the top level, choosing list or grid by count.
@@ -216,39 +203,11 @@ impl SceneAccel {
             .then(|| BoxLanes::new(entries.iter().map(|e| e.world_bounds)))
             .flatten()
             .map(Box::new);
-        let sides: Vec<ConvexSides> = sources
-            .par_iter()
-            .map(|source| {
-                let mesh = &scene.meshes[source.mesh(scene)];
-                convex_sides(&mesh.positions, &mesh.indices)
-            })
-            .collect();
-        let mut left_behind = vec![(NO_ENTRY, ConvexSides::default()); scene.instances.len()];
-        for (e, entry) in entries.iter().enumerate() {
-            left_behind[entry.instance as usize] = (e as u32, sides[entry.grid]);
-        }
         SceneAccel {
             grids,
             entries,
             instance_grid,
             list_bounds,
-            left_behind,
-        }
-    }
-
-    /// The entry a ray leaving `from` cannot meet again, or [`NO_ENTRY`].
-    #[inline(always)]
-    fn entry_left_behind(&self, from: Option<Leaving>) -> u32 {
-        match from {
-            Some(from) => {
-                let (entry, sides) = self.left_behind[from.instance as usize];
-                if sides.left_behind(from.front) {
-                    entry
-                } else {
-                    NO_ENTRY
-                }
-            }
-            None => NO_ENTRY,
         }
     }
 
@@ -262,36 +221,14 @@ impl SceneAccel {
         self.intersect_counting(ray, &mut ())
     }
 
-    /// The closest hit along `ray`, which starts on the surface `from` (if any): when that
-    /// surface is convex on the side the ray leaves by, its grid is not asked
-    /// ([`super::convex`]).
-    #[inline]
-    pub fn intersect_from(&self, ray: &Ray, from: Option<Leaving>) -> Option<SceneHit> {
-        self.intersect_skipping(ray, self.entry_left_behind(from), &mut ())
-    }
-
     /// [`SceneAccel::intersect`], reporting its work to `stats`.
     pub fn intersect_counting(
         &self,
         ray: &Ray,
         stats: &mut impl TraversalStats,
     ) -> Option<SceneHit> {
-        self.intersect_skipping(ray, NO_ENTRY, stats)
-    }
-
-    /// The closest hit along `ray` outside entry `skip`.
-    #[inline(always)]
-    fn intersect_skipping(
-        &self,
-        ray: &Ray,
-        skip: u32,
-        stats: &mut impl TraversalStats,
-    ) -> Option<SceneHit> {
         if self.is_one_entry() {
             stats.test_instance();
-            if skip == 0 {
-                return None;
-            }
             let hit =
                 self.ask_one_entry(ray, None, |grid, ray| grid.intersect_counting(ray, stats))?;
             return Some(self.scene_hit(0, hit, ray));
@@ -301,26 +238,17 @@ impl SceneAccel {
             TopIntersect {
                 accel: self,
                 ray,
-                skip,
                 stats: stats.lend(),
             },
         )
     }
 
     #[inline(always)]
-    fn intersect_portable(
-        &self,
-        ray: &Ray,
-        skip: u32,
-        stats: &mut impl TraversalStats,
-    ) -> Option<SceneHit> {
+    fn intersect_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> Option<SceneHit> {
         let mut best: Option<(u32, GridHit)> = None;
         let mut t_max = ray.t_max;
         let inv_direction = ray.direction.recip();
         let mut test = |e: u32, t_max: &mut f32, stats: &mut _| {
-            if e == skip {
-                return;
-            }
             if let Some(hit) = self.intersect_entry(e as usize, ray, inv_direction, *t_max, stats) {
                 *t_max = hit.t;
                 best = Some((e, hit));
@@ -335,7 +263,7 @@ impl SceneAccel {
                 // Only the entries whose bounds the ray meets, nearest entry first: a hit
                 // in a near entry ends the ray before the far ones, which are then not
                 // searched at all.
-                let mut met = slabs.met() & !skip_bit(skip);
+                let mut met = slabs.met();
                 while met != 0 {
                     let e = nearest_of(met, &slabs.start);
                     met &= !(1 << e);
@@ -404,26 +332,10 @@ impl SceneAccel {
         self.occluded_counting(ray, &mut ())
     }
 
-    /// [`SceneAccel::occluded`] for a ray that starts on the surface `from`, as
-    /// [`SceneAccel::intersect_from`] asks.
-    #[inline]
-    pub fn occluded_from(&self, ray: &Ray, from: Option<Leaving>) -> bool {
-        self.occluded_skipping(ray, self.entry_left_behind(from), &mut ())
-    }
-
     /// [`SceneAccel::occluded`], reporting its work to `stats`.
     pub fn occluded_counting(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
-        self.occluded_skipping(ray, NO_ENTRY, stats)
-    }
-
-    /// True when anything outside entry `skip` blocks `ray`.
-    #[inline(always)]
-    fn occluded_skipping(&self, ray: &Ray, skip: u32, stats: &mut impl TraversalStats) -> bool {
         if self.is_one_entry() {
             stats.test_instance();
-            if skip == 0 {
-                return false;
-            }
             return self.ask_one_entry(ray, false, |grid, ray| grid.occluded_counting(ray, stats));
         }
         dispatch(
@@ -431,14 +343,13 @@ impl SceneAccel {
             TopOccluded {
                 accel: self,
                 ray,
-                skip,
                 stats: stats.lend(),
             },
         )
     }
 
     #[inline(always)]
-    fn occluded_portable(&self, ray: &Ray, skip: u32, stats: &mut impl TraversalStats) -> bool {
+    fn occluded_portable(&self, ray: &Ray, stats: &mut impl TraversalStats) -> bool {
         let inv_direction = ray.direction.recip();
         match (&self.instance_grid, &self.list_bounds) {
             (None, Some(bounds)) => {
@@ -446,7 +357,7 @@ impl SceneAccel {
                 for _ in &self.entries {
                     stats.test_instance();
                 }
-                let mut met = slabs.met() & !skip_bit(skip);
+                let mut met = slabs.met();
                 while met != 0 {
                     let entry = &self.entries[met.trailing_zeros() as usize];
                     met &= met - 1;
@@ -459,15 +370,15 @@ impl SceneAccel {
                 }
                 false
             }
-            (None, None) => (0..self.entries.len())
-                .any(|e| e as u32 != skip && self.occluded_by(e, ray, inv_direction, stats)),
+            (None, None) => {
+                (0..self.entries.len()).any(|e| self.occluded_by(e, ray, inv_direction, stats))
+            }
             (Some(instance_grid), _) => {
                 let mut mailbox = Mailbox::new();
                 let mut blocked = false;
                 instance_grid.walk(ray, |ids, _| {
                     blocked = ids.iter().any(|&e| {
-                        e != skip
-                            && mailbox.first_visit(e)
+                        mailbox.first_visit(e)
                             && self.occluded_by(e as usize, ray, inv_direction, stats)
                     });
                     blocked
@@ -576,7 +487,6 @@ fn to_object(ray: &Ray, object_from_world: &Affine3A) -> Ray {
 struct TopIntersect<'a, S> {
     accel: &'a SceneAccel,
     ray: &'a Ray,
-    skip: u32,
     stats: S,
 }
 
@@ -584,8 +494,7 @@ impl<S: TraversalStats> Kernel for TopIntersect<'_, S> {
     type Output = Option<SceneHit>;
     #[inline(always)]
     fn run<const FUSED: bool>(mut self) -> Option<SceneHit> {
-        self.accel
-            .intersect_portable(self.ray, self.skip, &mut self.stats)
+        self.accel.intersect_portable(self.ray, &mut self.stats)
     }
 }
 
@@ -593,7 +502,6 @@ impl<S: TraversalStats> Kernel for TopIntersect<'_, S> {
 struct TopOccluded<'a, S> {
     accel: &'a SceneAccel,
     ray: &'a Ray,
-    skip: u32,
     stats: S,
 }
 
@@ -601,8 +509,7 @@ impl<S: TraversalStats> Kernel for TopOccluded<'_, S> {
     type Output = bool;
     #[inline(always)]
     fn run<const FUSED: bool>(mut self) -> bool {
-        self.accel
-            .occluded_portable(self.ray, self.skip, &mut self.stats)
+        self.accel.occluded_portable(self.ray, &mut self.stats)
     }
 }
 
@@ -690,14 +597,14 @@ mod tests {
             let fast = accel.intersect(&ray);
             assert_eq!(
                 fast,
-                accel.intersect_portable(&ray, NO_ENTRY, &mut ()),
+                accel.intersect_portable(&ray, &mut ()),
                 "ray {k}: {ray:?}"
             );
             hits += usize::from(fast.is_some());
             let segment = ray.with_t_max(1.0 + (k % 9) as f32);
             assert_eq!(
                 accel.occluded(&segment),
-                accel.occluded_portable(&segment, NO_ENTRY, &mut ()),
+                accel.occluded_portable(&segment, &mut ()),
                 "shadow ray {k}: {segment:?}"
             );
         }
@@ -755,8 +662,8 @@ mod tests {
                 let (found, answer) = answers(&one);
                 assert_eq!((found, answer), answers(&grid), "{case}, ray {k}: {ray:?}");
                 let portable = (
-                    one.intersect_portable(&ray, NO_ENTRY, &mut ()),
-                    one.occluded_portable(&segment, NO_ENTRY, &mut ()),
+                    one.intersect_portable(&ray, &mut ()),
+                    one.occluded_portable(&segment, &mut ()),
                 );
                 assert_eq!((found, answer), portable, "{case}, ray {k}: {ray:?}");
                 hits += usize::from(found.is_some());

@@ -2,7 +2,6 @@
 //! and a top level over the instances (a list, or a grid of their own when there are many).
 
 mod box_lanes;
-mod convex;
 mod grid;
 mod huge_pages;
 mod instances;
@@ -12,7 +11,6 @@ mod ray;
 mod top_level;
 mod triangle;
 
-pub use convex::Leaving;
 pub use grid::{Grid, GridHit, GridStats, TraversalCounts, TraversalStats};
 pub use instances::{SceneAccel, SceneHit, TopLevel};
 pub use ray::Ray;

@@ -26,16 +26,6 @@ pub(super) enum GridSource {
     Instance(usize),
 }
 
-impl GridSource {
-    /// Index into [`Scene::meshes`] of the mesh the grid is built over.
-    pub(super) fn mesh(&self, scene: &Scene) -> usize {
-        match self {
-            GridSource::Mesh(mesh) => *mesh,
-            GridSource::Instance(i) => scene.instances[*i].mesh,
-        }
-    }
-}
-
 /// How each scene instance is placed: meshes used more than once, and moving instances,
 /// stay in object space; a mesh placed once gets a world-space grid of its own.
 pub(super) fn placements(scene: &Scene) -> Vec<Placement> {

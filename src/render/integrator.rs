@@ -15,7 +15,7 @@ use super::sampler::Sampler;
 use super::sampling::power_heuristic;
 use super::shading::Shading;
 use super::surface::{Surface, surface_at};
-use crate::accel::{Leaving, Ray, SceneHit};
+use crate::accel::{Ray, SceneHit};
 use crate::geometry::offset_ray_origin;
 
 /// How direct light is estimated. Only [`Strategy::Mis`] is meant for images; the other two
@@ -152,8 +152,6 @@ struct Vertex<'a> {
 /// The state a path carries from vertex to vertex.
 struct Path {
     ray: Ray,
-    /// The surface the ray starts on, if any.
-    from: Option<Leaving>,
     /// Throughput from the camera.
     beta: Vec3,
     arrival: Arrival,
@@ -185,7 +183,6 @@ impl Path {
     fn new(ray: Ray, want_features: bool) -> Path {
         Path {
             ray,
-            from: None,
             beta: Vec3::ONE,
             arrival: Arrival::Specular,
             medium: None,
@@ -230,7 +227,6 @@ impl Path {
             self.ray.direction,
         )
         .at_time(s.time);
-        self.from = s.leaving(self.ray.direction);
         true
     }
 
@@ -257,7 +253,6 @@ impl Path {
 
     /// Samples the next direction at `vertex` and moves the path onto it; false when the
     /// path ends (no direction, a leak through the geometric surface, Russian roulette).
-    #[inline(always)]
     fn extend(
         &mut self,
         vertex: &Vertex,
@@ -304,7 +299,6 @@ impl Path {
             sample.wi,
         )
         .at_time(s.time);
-        self.from = s.leaving(sample.wi);
         self.vertex = s.point;
         self.vertex_normal = vertex.ns;
         self.travelled = 0.0;
@@ -375,7 +369,7 @@ impl Renderer<'_> {
         let mut path = Path::new(ray, options.want_features);
         loop {
             path.result.rays += 1;
-            let hit = self.accel.intersect_from(&path.ray, path.from);
+            let hit = self.accel.intersect(&path.ray);
             self.add_sphere_lamps(&mut path, hit.as_ref(), strategy);
             let Some(hit) = hit else {
                 self.leave_scene(&mut path, strategy);
@@ -612,12 +606,7 @@ impl Renderer<'_> {
             t_max: 1.0 - SHADOW_EPSILON,
             time: s.time,
         };
-        // The origin left the surface towards the light; a segment that turns back across
-        // the surface's plane (to a light in that plane) may still meet the surface.
-        let from = s
-            .leaving(ls.wi)
-            .filter(|&l| s.leaving(shadow.direction) == Some(l));
-        if self.occluded(&shadow, from, sampler) {
+        if self.occluded(&shadow, sampler) {
             return Vec3::ZERO;
         }
         let weight = match strategy {
@@ -631,14 +620,13 @@ impl Renderer<'_> {
 
     /// True when something blocks `shadow`. Surfaces that alpha hides do not; when the scene
     /// has any, the segment is walked hit by hit.
-    fn occluded(&self, shadow: &Ray, from: Option<Leaving>, sampler: &mut Sampler) -> bool {
+    fn occluded(&self, shadow: &Ray, sampler: &mut Sampler) -> bool {
         if !self.has_cutouts {
-            return self.accel.occluded_from(shadow, from);
+            return self.accel.occluded(shadow);
         }
         let mut ray = *shadow;
         for _ in 0..=MAX_PASS_THROUGHS {
-            // Still the same line from the same surface, which it cannot meet again.
-            let Some(hit) = self.accel.intersect_from(&ray, from) else {
+            let Some(hit) = self.accel.intersect(&ray) else {
                 return false;
             };
             let s = surface_at(self.scene, &self.frames, &hit);

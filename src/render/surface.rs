@@ -3,7 +3,7 @@
 
 use glam::{Affine3A, Mat3, Mat3A, Vec3, Vec3A};
 
-use crate::accel::{Leaving, SceneHit};
+use crate::accel::SceneHit;
 use crate::geometry::{interpolate_with_error, transform_points_with_error};
 use crate::scene::Scene;
 
@@ -28,18 +28,6 @@ pub struct Surface {
     pub barycentrics: Vec3,
     /// Shutter time of the path that found it: the rays it spawns see the scene then too.
     pub time: f32,
-}
-
-impl Surface {
-    /// This surface as the start of a ray along `direction`, which the scene's queries use
-    /// to pass over a convex mesh the ray leaves outward; none for a ray along the surface.
-    pub fn leaving(&self, direction: Vec3) -> Option<Leaving> {
-        let side = self.geometric_normal.dot(direction);
-        (side != 0.0).then_some(Leaving {
-            instance: self.instance as u32,
-            front: side > 0.0,
-        })
-    }
 }
 
 /// Per-instance data for turning object-space geometry into world space.
