@@ -127,7 +127,8 @@ pub struct OutputArgs {
 
     /// Report progress for a program to read: `json` prints a line after each pass but the
     /// last on stderr,
-    /// `{"pass":K,"of":N,"seconds":T}` (N: the most passes the render may take).
+    /// `{"pass":K,"of":N,"seconds":T}` (K: samples per pixel taken so far; N: the most the
+    /// render may take).
     #[arg(long, value_name = "FORMAT")]
     pub progress: Option<ProgressChoice>,
 

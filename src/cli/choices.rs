@@ -63,7 +63,8 @@ pub enum Switch {
 /// `--progress`: how progress is reported for programs (the Blender add-on).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ProgressChoice {
-    /// One JSON object per pass on stderr: `{"pass":K,"of":N,"seconds":T}`.
+    /// One JSON object per pass on stderr: `{"pass":K,"of":N,"seconds":T}` (K samples per
+    /// pixel of N taken).
     Json,
 }
 

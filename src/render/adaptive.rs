@@ -44,6 +44,14 @@ impl Schedule {
         passes >= self.min_samples && (passes - self.min_samples).is_multiple_of(CHECK_EVERY)
     }
 
+    /// Passes from `done` to the next pass count after which pixels are judged.
+    pub fn passes_until_check(&self, done: u32) -> u32 {
+        if done < self.min_samples {
+            return self.min_samples - done;
+        }
+        CHECK_EVERY - (done - self.min_samples) % CHECK_EVERY
+    }
+
     /// The estimated error of a pixel's mean over its `n` samples.
     pub fn error(beauty: &PixelAccumulator, features: &FeatureAccumulator, n: u32) -> f64 {
         if n < 2 {
@@ -79,6 +87,20 @@ mod tests {
             f.add(&Features::default(), Vec3::splat(v));
         }
         (b, f)
+    }
+
+    /// The passes to the next check lead, from every pass count, to the first count after
+    /// it that [`Schedule::check_after`] accepts.
+    #[test]
+    fn the_next_check_is_the_first_pass_count_checked() {
+        for spp in [1, 16, 20, 100, 1024] {
+            let schedule = Schedule::new(0.01, spp);
+            for done in 0..spp {
+                let next = done + schedule.passes_until_check(done);
+                let first = (done + 1..).find(|&p| schedule.check_after(p)).unwrap();
+                assert_eq!(next, first, "spp {spp}, after {done}");
+            }
+        }
     }
 
     #[test]

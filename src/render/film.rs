@@ -249,6 +249,16 @@ impl Film {
         (width as u64 * height as u64).saturating_mul(per_pixel)
     }
 
+    /// Pixels per row.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// True when the film keeps features, so paths should report them.
+    pub fn wants_features(&self) -> bool {
+        !self.features.is_empty()
+    }
+
     /// The rows, to be filled in parallel.
     pub fn rows(&mut self) -> Vec<FilmRow<'_>> {
         let w = self.width.max(1);

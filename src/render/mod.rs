@@ -5,6 +5,7 @@
 
 pub(crate) mod adaptive;
 pub(crate) mod aov;
+mod batches;
 mod bsdf;
 mod camera;
 #[cfg(test)]
@@ -40,6 +41,7 @@ use rayon::prelude::*;
 
 use crate::accel::{Ray, SceneAccel, TopLevel};
 use crate::scene::{Camera, Scene};
+use batches::{Batches, Bounds};
 use guiding::{Guide, guiding_at};
 use sampler::Sampler;
 use sampling::mix64;
@@ -137,7 +139,7 @@ pub enum EarlyEnd {
     Stopped,
     /// Adaptive sampling: every pixel reached the noise threshold.
     Converged,
-    /// The next pass would have ended after the time limit.
+    /// One more sample per pixel would have ended after the time limit.
     TimeLimit,
 }
 
@@ -228,9 +230,10 @@ impl<'a> Renderer<'a> {
         self.render_until(camera, settings, on_row, &AtomicBool::new(false))
     }
 
-    /// Renders in passes of one sample per pixel, stopping early after the pass during which
-    /// `stop` becomes true; the image then holds the samples of the finished passes
-    /// ([`Image::spp`]).
+    /// Renders in passes over every pixel — one sample per pixel, then batches of samples
+    /// that fill about a quarter of a second ([`batches`]) — stopping early after the pass
+    /// during which `stop` becomes true; the image then holds the samples of the finished
+    /// passes ([`Image::spp`]).
     ///
     /// Every sample draws from its own random stream, keyed by the seed, the pixel index and
     /// the sample index ([`Sampler::for_sample`]), and each pixel sums its samples in a fixed
@@ -243,19 +246,19 @@ impl<'a> Renderer<'a> {
         on_row: &(dyn Fn() + Sync),
         stop: &AtomicBool,
     ) -> (Image, RenderStats) {
-        self.render_with_checkpoints(camera, settings, on_row, stop, &mut |_| {})
+        self.render_with_checkpoints(camera, settings, on_row, stop, &mut |_, _| {})
     }
 
-    /// [`Renderer::render_until`], calling `on_pass` after every pass but the last with a
-    /// function that makes the image of the samples so far, for checkpoints: `on_pass`
-    /// decides whether it is worth making.
+    /// [`Renderer::render_until`], calling `on_pass` after every pass but the last with the
+    /// samples per pixel taken so far and a function that makes the image of them, for
+    /// checkpoints: `on_pass` decides whether it is worth making.
     pub fn render_with_checkpoints(
         &self,
         camera: &Camera,
         settings: &RenderSettings,
         on_row: &(dyn Fn() + Sync),
         stop: &AtomicBool,
-        on_pass: &mut dyn FnMut(ImageSoFar),
+        on_pass: &mut dyn FnMut(u32, ImageSoFar),
     ) -> (Image, RenderStats) {
         let start = Instant::now();
         let view = CameraSampling {
@@ -263,7 +266,6 @@ impl<'a> Renderer<'a> {
             filter: PixelFilter::new(settings.filter, settings.filter_width),
             timed: camera.motion.is_some() || self.scene.has_moving_geometry(),
         };
-        let width = settings.width as usize;
         let first_sample = settings.samples.start;
         let spp = settings.spp().max(1);
         let seed = mix64(settings.seed);
@@ -294,44 +296,39 @@ impl<'a> Renderer<'a> {
             stats.elapsed = start.elapsed();
             (image, stats)
         };
+        let mut batches = Batches::default();
         while stats.spp < spp {
-            let pass_start = Instant::now();
+            let batch_start = Instant::now();
             let sample = first_sample + stats.spp;
             let guiding = guiding_at(guide.as_ref(), sample);
-            let (rays, samples) = film
-                .rows()
-                .into_par_iter()
-                .map(|mut row| {
-                    let (mut rays, mut samples) = (0u64, 0u64);
-                    let wants_features = row.wants_features();
-                    for x in 0..row.len() {
-                        if !row.is_active(x) {
-                            continue;
-                        }
-                        let pixel = (row.y * width + x) as u64;
-                        let mut sampler = Sampler::for_sample(seed, pixel, sample);
-                        let ray = view.ray(x, row.y, &mut sampler);
-                        let options = PathOptions {
-                            max_depth: settings.max_depth,
-                            strategy: settings.strategy,
-                            want_features: wants_features,
-                            guiding,
-                            next_event,
-                        };
-                        let path = self.trace_path_with(ray, &mut sampler, options);
-                        rays += path.rays;
-                        samples += 1;
-                        row.add(x, path.radiance, path.hit, &path.features);
-                    }
-                    on_row();
-                    (rays, samples)
-                })
-                .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+            let passes = batches.next(Bounds {
+                remaining: spp - stats.spp,
+                until_check: adaptive.map(|a| a.passes_until_check(stats.spp)),
+                training: matches!(guiding, PathGuiding::Train(_)),
+                time_left: settings
+                    .time_limit
+                    .map(|limit| limit.saturating_sub(start.elapsed())),
+            });
+            let options = PathOptions {
+                max_depth: settings.max_depth,
+                strategy: settings.strategy,
+                want_features: film.wants_features(),
+                guiding,
+                next_event,
+            };
+            let (rays, samples) = self.sweep(
+                &mut film,
+                &view,
+                (seed, sample..sample + passes),
+                options,
+                on_row,
+            );
+            batches.record(passes, batch_start.elapsed());
             stats.rays += rays;
             stats.samples += samples;
-            stats.spp += 1;
+            stats.spp += passes;
             if let Some(guide) = &mut guide {
-                guide.after_sample(sample);
+                (sample..sample + passes).for_each(|s| guide.after_sample(s));
             }
             if stats.spp == spp {
                 break;
@@ -348,13 +345,91 @@ impl<'a> Renderer<'a> {
                 break;
             }
             if let Some(limit) = settings.time_limit
-                && start.elapsed() + pass_start.elapsed() > limit
+                && start.elapsed() + batches.per_pass().unwrap_or_default() > limit
             {
                 stats.ended_early = Some(EarlyEnd::TimeLimit);
                 break;
             }
-            on_pass(&|| image_so_far(&film, stats));
+            on_pass(stats.spp, &|| image_so_far(&film, stats));
         }
         image_so_far(&film, stats)
+    }
+
+    /// Takes samples `samples` (with the seed before them) of every active pixel of `film`,
+    /// in parallel over its rows; each pixel adds its samples in ascending order, so the
+    /// sums do not depend on how the samples are batched. Returns the rays traced and the
+    /// samples taken.
+    fn sweep(
+        &self,
+        film: &mut Film,
+        view: &CameraSampling,
+        (seed, samples): (u64, Range<u32>),
+        options: PathOptions,
+        on_row: &(dyn Fn() + Sync),
+    ) -> (u64, u64) {
+        let width = film.width();
+        film.rows()
+            .into_par_iter()
+            .map(|mut row| {
+                let (mut rays, mut taken) = (0u64, 0u64);
+                for x in 0..row.len() {
+                    if !row.is_active(x) {
+                        continue;
+                    }
+                    let pixel = (row.y * width + x) as u64;
+                    for sample in samples.clone() {
+                        let mut sampler = Sampler::for_sample(seed, pixel, sample);
+                        let ray = view.ray(x, row.y, &mut sampler);
+                        let path = self.trace_path_with(ray, &mut sampler, options);
+                        rays += path.rays;
+                        taken += 1;
+                        row.add(x, path.radiance, path.hit, &path.features);
+                    }
+                }
+                samples.clone().for_each(|_| on_row());
+                (rays, taken)
+            })
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::load::load_scene;
+
+    /// Sweeps of several samples per pixel fill the film exactly as sweeps of one sample
+    /// each: the same sums, bit for bit, features and all.
+    #[test]
+    fn batches_of_samples_fill_the_film_as_single_samples_do() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell_box.glb");
+        let scene = load_scene(&path).expect("the bundled scene loads").scene;
+        let renderer = Renderer::new(&scene);
+        let (width, height) = (24, 16);
+        let view = CameraSampling {
+            generator: RayGenerator::new(&scene.cameras[0], width, height),
+            filter: PixelFilter::new(FilterKind::Box, 1.0),
+            timed: false,
+        };
+        let options = PathOptions::plain(16, Strategy::Mis);
+        let fill = |batches: &[u32]| {
+            let mut film = Film::new(width, height, 0, AovSet::ALL, true);
+            let options = PathOptions {
+                want_features: true,
+                ..options
+            };
+            let mut start = 0;
+            for &n in batches {
+                renderer.sweep(&mut film, &view, (7, start..start + n), options, &|| {});
+                start += n;
+            }
+            film.resolve(start).0
+        };
+        let one_by_one = fill(&[1; 11]);
+        let batched = fill(&[1, 2, 8]);
+        assert_eq!(one_by_one.pixels, batched.pixels);
+        assert_eq!(one_by_one.alpha, batched.alpha);
+        assert_eq!(one_by_one.aovs, batched.aovs);
+        assert!(one_by_one.pixels.iter().any(|p| p.max_element() > 0.0));
     }
 }

@@ -129,11 +129,9 @@ pub fn render_passes(
         view: args.image.view_transform.into(),
     };
     let most_passes = settings.spp();
-    let mut passes_done = 0u32;
     let report_progress = args.image.progress.is_some();
     let started = Instant::now();
-    let mut on_pass = |image_so_far: &dyn Fn() -> (Image, RenderStats)| {
-        passes_done += 1;
+    let mut on_pass = |passes_done: u32, image_so_far: &dyn Fn() -> (Image, RenderStats)| {
         if report_progress {
             crate::terminal::say(format_args!(
                 "{{\"pass\":{passes_done},\"of\":{most_passes},\"seconds\":{:.3}}}",
