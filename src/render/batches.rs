@@ -45,7 +45,9 @@ impl Batches {
             return 1;
         };
         let fits = |time: Duration| (time.as_secs_f64() / per_pass.as_secs_f64().max(1e-9)) as u32;
-        let mut passes = fits(TARGET).min(2 * self.last).min(bounds.remaining);
+        let mut passes = fits(TARGET)
+            .min(self.last.saturating_mul(2))
+            .min(bounds.remaining);
         if let Some(until_check) = bounds.until_check {
             passes = passes.min(until_check);
         }

@@ -173,11 +173,6 @@ impl FilmRow<'_> {
         self.active.is_none_or(|a| a[x])
     }
 
-    /// True when the film keeps features, so paths should report them.
-    pub fn wants_features(&self) -> bool {
-        self.features.is_some()
-    }
-
     /// Adds one sample to pixel `x`.
     pub fn add(&mut self, x: usize, radiance: Vec3, hit: bool, features: &Features) {
         self.beauty[x].add(radiance, hit);
