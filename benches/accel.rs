@@ -32,7 +32,8 @@ mod oracles;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use gridtrace::accel::{Grid, Ray, TraversalCounts, TraversalStats};
+use glam::{Vec2, Vec3};
+use gridtrace::accel::{Grid, Ray, TraversalCounts, TraversalStats, View, ViewGrid};
 use gridtrace::geometry::Aabb;
 use gridtrace::load::ply;
 use oracles::embree::Embree;
@@ -103,18 +104,53 @@ fn run_chunks(rays: &[Ray], queries: &[ChunkQuery], run: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The view grid ([`ViewGrid`]) of the eye all of `rays` start from, over a window that
+/// holds every ray's direction, one column per ray at most.
+fn view_of_rays(rays: &[Ray]) -> View {
+    let eye = rays[0].origin;
+    let forward = rays
+        .iter()
+        .map(|r| r.direction.normalize())
+        .sum::<Vec3>()
+        .normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let on_plane = |d: Vec3| Vec2::new(d.dot(right), d.dot(up)) / d.dot(forward);
+    let (lo, hi) = rays
+        .iter()
+        .fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(lo, hi), r| {
+            let p = on_plane(r.direction);
+            (lo.min(p), hi.max(p))
+        });
+    let pad = 0.01 * (hi - lo);
+    View {
+        eye,
+        right,
+        up,
+        forward,
+        lo: lo - pad,
+        hi: hi + pad,
+        max_columns: (rays.len() as f64
+            * std::env::var("VIEW_COLUMNS_PER_RAY")
+                .ok()
+                .and_then(|v| v.parse::<f64>().ok())
+                .unwrap_or(1.0)) as u32,
+    }
+}
+
 /// Camera rays (in tiles of 8 × 8, [`camera_rays`]): the grid's single rays against
 /// Embree's widest native packet query (`rtcIntersect16` or `8`) besides its
-/// `rtcIntersect1`, each packet a run of consecutive rays of one tile. A table row as the
-/// main table's (the grid over Embree's packets) and a note.
-fn embree_packet_rows(
+/// `rtcIntersect1`, each packet a run of consecutive rays of one tile, and the view grid of
+/// the camera's eye ([`ViewGrid`], its build timed apart). Table rows as the main table's
+/// (the grid, then the view grid, over Embree's packets) and notes.
+fn camera_rows(
     model: &str,
     n: usize,
     grid: &Grid,
     embree: &Embree,
     rays: &[Ray],
     runs: usize,
-) -> (String, String) {
+) -> (Vec<String>, Vec<String>) {
     let width = embree.native_packet();
     let embree_packets = |c: &[Ray]| {
         let mut hits = [None; 16];
@@ -133,28 +169,67 @@ fn embree_packet_rows(
             })
             .sum()
     };
+    let view = view_of_rays(rays);
+    let builds: Vec<(ViewGrid, Duration)> = (0..5)
+        .map(|_| timed(|| ViewGrid::build(&[grid], view).expect("the dragon lies ahead")))
+        .collect();
+    let build_s = summary(builds.iter().map(|b| b.1.as_secs_f64()).collect()).0;
+    let view_grid = &builds[0].0;
+    let differing = rays
+        .iter()
+        .filter(|r| {
+            let expected = grid.intersect(r).map(|h| (h.t, h.triangle));
+            let got = view_grid
+                .intersect(r)
+                .expect("every camera ray is in the window");
+            got.map(|h| (h.t, h.triangle)) != expected
+        })
+        .count();
     let queries: Vec<ChunkQuery> = vec![
         Box::new(|c: &[Ray]| c.iter().filter(|r| grid.intersect(r).is_some()).count()),
         Box::new(|c: &[Ray]| c.iter().filter(|r| embree.intersect(r).is_some()).count()),
         Box::new(embree_packets),
+        Box::new(|c: &[Ray]| {
+            (c.iter())
+                .filter(|r| view_grid.intersect(r).is_some_and(|h| h.is_some()))
+                .count()
+        }),
     ];
     let rates: Vec<Vec<f64>> = (0..runs)
         .map(|run| run_chunks(rays, &queries, run))
         .collect();
     let median = |q: usize| summary(rates.iter().map(|r| r[q]).collect()).0;
-    let (ratio, lo, hi) = summary(rates.iter().map(|r| r[0] / r[2]).collect());
-    let row = format!(
-        "| {model} | {n} | camera-vs-{width} | {:.3} | {:.3} | – | {ratio:.2} ({lo:.2}–{hi:.2}) | – |",
-        median(0),
-        median(2)
-    );
-    let note = format!(
-        "{model}, camera rays (8 × 8 tiles), Mrays/s (median of {runs}): grid {:.3}, Embree rtcIntersect1 {:.3}, Embree packets of {width} {:.3}",
-        median(0),
-        median(1),
-        median(2)
-    );
-    (row, note)
+    let row = |name: &str, q: usize, over: usize| {
+        let (ratio, lo, hi) = summary(rates.iter().map(|r| r[q] / r[over]).collect());
+        format!(
+            "| {model} | {n} | {name} | {:.3} | {:.3} | – | {ratio:.2} ({lo:.2}–{hi:.2}) | – |",
+            median(q),
+            median(over)
+        )
+    };
+    let rows = vec![
+        row(&format!("camera-vs-{width}"), 0, 2),
+        row("view-camera", 3, 1),
+        row(&format!("view-camera-vs-{width}"), 3, 2),
+    ];
+    let bytes = view_grid.bytes();
+    let notes = vec![
+        format!(
+            "{model}, camera rays (8 × 8 tiles), Mrays/s (median of {runs}): grid {:.3}, view grid {:.3}, Embree rtcIntersect1 {:.3}, Embree packets of {width} {:.3}",
+            median(0),
+            median(3),
+            median(1),
+            median(2)
+        ),
+        format!(
+            "{model}, view grid: {}x{} columns, build {build_s:.4} s (median of 5), {:.1} bytes/triangle; {differing} of {} camera rays answered otherwise than by the grid (t or triangle)",
+            view_grid.columns().x,
+            view_grid.columns().y,
+            bytes as f64 / n as f64,
+            rays.len()
+        ),
+    ];
+    (rows, notes)
 }
 
 /// The medians over `runs` runs of the two figures `run_pair(run)` gives.
@@ -617,9 +692,9 @@ fn main() {
                 ));
             }
         }
-        let (row, note) = embree_packet_rows(model, n, &grid, &embree, &sets[1].1, runs);
-        println!("{row}");
-        notes.push(note);
+        let (rows, camera_notes) = camera_rows(model, n, &grid, &embree, &sets[1].1, runs);
+        rows.iter().for_each(|row| println!("{row}"));
+        notes.extend(camera_notes);
         // Scaling of the grid over all threads, best of 5, each timing the ray set traced
         // as many times over as make it last about 0.2 s on one thread (on the small
         // meshes one pass takes a few milliseconds, too short for thread start-up and the

@@ -8,12 +8,16 @@ mod instances;
 mod isa;
 mod placement;
 mod ray;
+mod scene_view;
 mod top_level;
 mod triangle;
 
-pub use grid::{Grid, GridHit, GridStats, TraversalCounts, TraversalStats};
+pub use grid::{
+    Grid, GridHit, GridStats, TraversalCounts, TraversalStats, View, ViewGrid, ViewHit,
+};
 pub use instances::{SceneAccel, SceneHit, TopLevel};
 pub use ray::Ray;
+pub use scene_view::SceneView;
 pub use triangle::{Triangle, TriangleHit};
 
 /// γ(3): the relative rounding error of a slab distance.

@@ -18,8 +18,10 @@ mod build;
 mod cell_lanes;
 pub(crate) mod frame;
 mod storage;
+mod view;
 pub(crate) mod walk;
 
+pub use view::{View, ViewGrid, ViewHit};
 pub use walk::stats::{TraversalCounts, TraversalStats};
 
 use glam::{UVec3, Vec3};
@@ -123,6 +125,21 @@ impl Grid {
     #[inline]
     fn storage_key(&self, c: UVec3) -> usize {
         CellIndex::storage_key(CellIndex::macro_resolution_for(self.frame.resolution), c)
+    }
+
+    /// Every triangle of the grid once, as its blocks hold it (the very numbers the walk
+    /// tests), with its index in the mesh, in the order of first appearance.
+    pub(crate) fn unique_triangles(&self) -> Vec<(crate::accel::Triangle, u32)> {
+        let mut seen = vec![false; self.triangle_count];
+        let mut triangles = Vec::with_capacity(self.inserted);
+        for block in &self.blocks {
+            for (triangle, id) in (0..block::LANES).filter_map(|l| block.get(l)) {
+                if !std::mem::replace(&mut seen[id as usize], true) {
+                    triangles.push((triangle, id));
+                }
+            }
+        }
+        triangles
     }
 
     /// Checks the structure's invariants; returns a description of the first broken one.
