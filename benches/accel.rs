@@ -19,12 +19,16 @@
 //! that are blocked and those that pass), each part timed alone, and the grid's speed-up on
 //! all threads (bounce rays, each timing about 0.2 s long). The camera rays, which come in
 //! tiles of 8 × 8, are also timed against Embree's widest native packet query
-//! (`rtcIntersect16` here): row `camera-vs-16`, the grid's single rays over Embree's packets.
+//! (`rtcIntersect16` or `8`): row `camera-vs-16`, the grid's single rays over Embree's
+//! packets; and the grid of the camera's eye ([`ViewGrid`], four columns per ray, its build
+//! timed apart, its answers compared with the grid's): rows `view-camera` (over Embree's
+//! `rtcIntersect1`) and `view-camera-vs-16` (over its packets).
 //!
 //! Run with `cargo bench --bench accel` after `tools/dev/setup.sh`. Environment:
 //! `ACCEL_BENCH_MODELS` (comma-separated files of data/dragon, default the smallest, a
 //! middle one and the full dragon), `ACCEL_BENCH_RAYS` (rays per set, default 100,000),
-//! `ACCEL_BENCH_RUNS` (default 5), `ACCEL_BENCH_DENSITY` (the grid's cells per triangle).
+//! `ACCEL_BENCH_RUNS` (default 5), `ACCEL_BENCH_DENSITY` (the grid's cells per triangle),
+//! `ACCEL_BENCH_VIEW_COLUMNS` (the view grid's columns per camera ray, default 4).
 
 #[path = "../tests/support/oracles/mod.rs"]
 mod oracles;
@@ -104,8 +108,12 @@ fn run_chunks(rays: &[Ray], queries: &[ChunkQuery], run: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The view grid ([`ViewGrid`]) of the eye all of `rays` start from, over a window that
-/// holds every ray's direction, one column per ray at most.
+/// Columns of the view grid per camera ray unless `ACCEL_BENCH_VIEW_COLUMNS` says
+/// otherwise: as the renderer's per pixel.
+const VIEW_COLUMNS_PER_RAY: usize = 4;
+
+/// The view ([`View`]) of the eye all of `rays` start from, over a window that holds every
+/// ray's direction, [`VIEW_COLUMNS_PER_RAY`] columns per ray at most.
 fn view_of_rays(rays: &[Ray]) -> View {
     let eye = rays[0].origin;
     let forward = rays
@@ -130,11 +138,7 @@ fn view_of_rays(rays: &[Ray]) -> View {
         forward,
         lo: lo - pad,
         hi: hi + pad,
-        max_columns: (rays.len() as f64
-            * std::env::var("VIEW_COLUMNS_PER_RAY")
-                .ok()
-                .and_then(|v| v.parse::<f64>().ok())
-                .unwrap_or(1.0)) as u32,
+        max_columns: (env_or("ACCEL_BENCH_VIEW_COLUMNS", VIEW_COLUMNS_PER_RAY) * rays.len()) as u32,
     }
 }
 

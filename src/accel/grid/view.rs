@@ -4,7 +4,7 @@
 //! Every ray from the eye is one point of the plane one unit ahead of it, so the grid is a
 //! 2D array of columns over a window of that plane; a triangle goes into each column its
 //! projection's bounds (with a margin for rounding) meet, and a column's triangles are kept
-//! nearest first, in blocks of eight. A ray finds its column with a division and two
+//! nearest first, the columns one after another in blocks of eight. A ray finds its column with a division and two
 //! multiplications, then tests the column's blocks until the next block's least depth lies
 //! beyond the nearest hit found: no walk, and a ray that misses everything reads one word.
 //! The triangles are the grids' own (the numbers their blocks hold, tested by the same
@@ -91,10 +91,11 @@ pub struct ViewGrid {
     columns: UVec2,
     /// Columns per unit of the plane, horizontally and vertically.
     scale: Vec2,
-    /// The first block of each column, row after row; one more entry, the end.
+    /// The first lane of each column, row after row, counting the lanes of all blocks in
+    /// turn; one more entry, the end.
     starts: Vec<u32>,
     blocks: Vec<Block>,
-    /// The least depth of each block's triangles less a margin; rising within a column.
+    /// The least depth of each block's triangles less a margin ([`fill_columns`]).
     depths: Vec<f32>,
     /// Triangles too near the eye's plane to project ([`NEAR_SHARE`]), for every ray.
     near: Vec<Block>,
@@ -146,6 +147,9 @@ impl ViewGrid {
             if references <= REFERENCES_PER_TRIANGLE * placed + (columns.x * columns.y) as usize
                 || columns == UVec2::ONE
             {
+                if references > u32::MAX as usize {
+                    return None;
+                }
                 break ranges;
             }
             columns = (columns / 2).max(UVec2::ONE);
@@ -230,7 +234,12 @@ impl ViewGrid {
         for block in &self.near {
             test(block, &mut t_max);
         }
-        let range = self.starts[column] as usize..self.starts[column + 1] as usize;
+        let lanes = self.starts[column] as usize..self.starts[column + 1] as usize;
+        // An empty column tests nothing (not the block its place falls in).
+        let range = match lanes.is_empty() {
+            true => 0..0,
+            false => lanes.start / LANES..lanes.end.div_ceil(LANES),
+        };
         for (block, &depth) in self.blocks[range.clone()].iter().zip(&self.depths[range]) {
             // Every later block's triangles lie at least this deep: past the hit found.
             if depth > t_max * w {
@@ -338,7 +347,12 @@ fn fill_blocks<'a>(triangles: impl Iterator<Item = (&'a Triangle, u32)>) -> Vec<
 }
 
 /// The columns' blocks: each column's triangles by least depth (then index, so the grid is
-/// the same on any thread count), eight to a block, and each block's least depth.
+/// the same on any thread count), the columns one after another in lanes of blocks of
+/// eight with no lane left empty, and each block's least depth. A block may hold the end
+/// of one column and the start of the next: a ray then also tests the other column's
+/// triangles there, which can only find real hits no nearer than the nearest, and every
+/// later triangle of its own column still lies at least as deep as the block's least depth.
+/// Returns the first lane of each column (and the end), the blocks and their depths.
 fn fill_columns(
     triangles: &[(Triangle, (u32, u32))],
     places: &[Place],
@@ -369,30 +383,32 @@ fn fill_columns(
             next[c] += 1;
         }
     }
-    let mut slices = Vec::with_capacity(count);
+    let mut parts = Vec::with_capacity(count);
     let mut rest = references.as_mut_slice();
     for c in 0..count {
-        let (column, after) = rest.split_at_mut(starts[c + 1] - starts[c]);
-        slices.push(column);
+        let (column, after) = std::mem::take(&mut rest).split_at_mut(starts[c + 1] - starts[c]);
+        parts.push(column);
         rest = after;
     }
-    slices
-        .par_iter_mut()
-        .for_each(|column| column.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))));
-    let mut block_starts = Vec::with_capacity(count + 1);
-    let mut blocks = Vec::new();
-    let mut depths = Vec::new();
-    for column in &slices {
-        block_starts.push(blocks.len() as u32);
-        for chunk in column.chunks(LANES) {
-            depths.push(chunk[0].0);
-            blocks.extend(fill_blocks(
-                chunk.iter().map(|&(_, i)| (&triangles[i as usize].0, i)),
-            ));
-        }
-    }
-    block_starts.push(blocks.len() as u32);
-    (block_starts, blocks, depths)
+    parts.into_par_iter().for_each(|column| {
+        column.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    });
+    let total = references.len().div_ceil(LANES);
+    // A ray's column lies anywhere in the blocks: 2 MiB pages spare it a TLB miss, as for
+    // the grids' blocks.
+    let mut blocks = crate::accel::huge_pages::vec_with_capacity(total);
+    blocks.resize(total, Block::EMPTY);
+    let mut depths = vec![0.0f32; total];
+    (blocks.par_iter_mut().zip(&mut depths))
+        .zip(references.par_chunks(LANES))
+        .for_each(|((block, depth), chunk)| {
+            *depth = chunk.iter().map(|r| r.0).fold(f32::INFINITY, f32::min);
+            for (lane, &(_, i)) in chunk.iter().enumerate() {
+                block.set(lane, &triangles[i as usize].0, i);
+            }
+        });
+    let starts = starts.iter().map(|&s| s as u32).collect();
+    (starts, blocks, depths)
 }
 
 /// The column query as a [`Kernel`]: the blocks' eight lanes are one vector with AVX2 and
