@@ -211,17 +211,6 @@ impl SceneAccel {
         }
     }
 
-    /// Every entry's grid and the instance it places, when each takes world rays as they
-    /// are ([`Entry::takes_world_rays`]); `None` otherwise.
-    pub(super) fn world_grids(&self) -> Option<Vec<(&Grid, u32)>> {
-        (self.entries.iter())
-            .map(|e| {
-                e.takes_world_rays()
-                    .then(|| (&self.grids[e.grid], e.instance))
-            })
-            .collect()
-    }
-
     /// Cells per axis of the instance grid, when the entries are in one.
     pub fn instance_grid_resolution(&self) -> Option<glam::UVec3> {
         self.instance_grid.as_ref().map(InstanceGrid::resolution)

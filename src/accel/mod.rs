@@ -1,5 +1,6 @@
 //! Ray–scene intersection: the Möller–Trumbore triangle test, a uniform grid per mesh,
-//! and a top level over the instances (a list, or a grid of their own when there are many).
+//! and a top level over the instances (a list, or a grid of their own when there are many);
+//! and a grid of one eye point's view, for the rays of a pinhole camera ([`ViewGrid`]).
 
 mod box_lanes;
 mod grid;
@@ -8,7 +9,6 @@ mod instances;
 mod isa;
 mod placement;
 mod ray;
-mod scene_view;
 mod top_level;
 mod triangle;
 
@@ -17,7 +17,6 @@ pub use grid::{
 };
 pub use instances::{SceneAccel, SceneHit, TopLevel};
 pub use ray::Ray;
-pub use scene_view::SceneView;
 pub use triangle::{Triangle, TriangleHit};
 
 /// γ(3): the relative rounding error of a slab distance.

@@ -3,7 +3,7 @@
 use glam::{Affine3A, Vec2, Vec3};
 
 use super::sampling::concentric_disk;
-use crate::accel::{Ray, View};
+use crate::accel::Ray;
 use crate::scene::{Camera, Motion, Projection, ThinLens};
 
 /// Generates the ray through a point of the image plane.
@@ -83,52 +83,6 @@ impl RayGenerator {
             (ndc.x + 1.0) * 0.5 * self.width as f32,
             (1.0 - ndc.y) * 0.5 * self.height as f32,
         )
-    }
-
-    /// The eye and window of a still pinhole camera's rays for a [`crate::accel::ViewGrid`]:
-    /// the window holds the directions of rays through the image grown by `margin` pixels on
-    /// every side (a pixel filter's reach), with 1 % to spare. `None` for a camera with a
-    /// lens, a moving one, or an orthographic one, whose rays do not share an eye.
-    pub fn view(&self, margin: f32, max_columns: u32) -> Option<View> {
-        let perspective = matches!(self.projection, Projection::Perspective { .. });
-        if !perspective || self.lens.is_some() || self.motion.is_some() {
-            return None;
-        }
-        let m = &self.world_from_camera;
-        let forward = m.transform_vector3(Vec3::NEG_Z).try_normalize()?;
-        let right = m
-            .transform_vector3(Vec3::X)
-            .reject_from(forward)
-            .try_normalize()?;
-        let up = forward.cross(right);
-        let (w, h) = (self.width as f32, self.height as f32);
-        let corners = [
-            (-margin, -margin),
-            (w + margin, -margin),
-            (-margin, h + margin),
-            (w + margin, h + margin),
-        ];
-        let (mut lo, mut hi) = (Vec2::INFINITY, Vec2::NEG_INFINITY);
-        for (x, y) in corners {
-            let d = self.generate(x, y).direction;
-            let depth = d.dot(forward);
-            if depth.is_nan() || depth <= 0.0 {
-                return None;
-            }
-            let p = Vec2::new(d.dot(right), d.dot(up)) / depth;
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-        let pad = 0.01 * (hi - lo);
-        (lo.is_finite() && hi.is_finite()).then_some(View {
-            eye: self.generate(0.0, 0.0).origin,
-            right,
-            up,
-            forward,
-            lo: lo - pad,
-            hi: hi + pad,
-            max_columns,
-        })
     }
 
     /// True when rays leave a lens of some size: each sample then needs a lens position.

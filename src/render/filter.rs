@@ -89,12 +89,6 @@ impl PixelFilter {
         self.kind
     }
 
-    /// The footprint's full width in pixels: a sample lies at most half of it from the
-    /// pixel's centre.
-    pub fn support(&self) -> f32 {
-        self.support
-    }
-
     /// Its width in pixels.
     pub fn width(&self) -> f32 {
         self.width

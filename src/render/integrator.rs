@@ -15,7 +15,7 @@ use super::sampler::Sampler;
 use super::sampling::power_heuristic;
 use super::shading::Shading;
 use super::surface::{Surface, surface_at};
-use crate::accel::{Ray, SceneHit, SceneView};
+use crate::accel::{Ray, SceneHit};
 use crate::geometry::offset_ray_origin;
 
 /// How direct light is estimated. Only [`Strategy::Mis`] is meant for images; the other two
@@ -120,9 +120,6 @@ pub struct PathOptions<'a> {
     pub guiding: PathGuiding<'a>,
     /// How next-event estimates are taken.
     pub next_event: NextEvent<'a>,
-    /// The grid of the camera's eye, which answers the path's first ray when it is one of
-    /// the eye's ([`SceneView`]); the same hit the scene's grids give.
-    pub eye: Option<&'a SceneView>,
 }
 
 impl PathOptions<'_> {
@@ -134,7 +131,6 @@ impl PathOptions<'_> {
             want_features: false,
             guiding: PathGuiding::Off,
             next_event: NextEvent::Always,
-            eye: None,
         }
     }
 }
@@ -373,10 +369,7 @@ impl Renderer<'_> {
         let mut path = Path::new(ray, options.want_features);
         loop {
             path.result.rays += 1;
-            let hit = match options.eye {
-                Some(eye) if path.result.rays == 1 => eye.intersect(&self.accel, &path.ray),
-                _ => self.accel.intersect(&path.ray),
-            };
+            let hit = self.accel.intersect(&path.ray);
             self.add_sphere_lamps(&mut path, hit.as_ref(), strategy);
             let Some(hit) = hit else {
                 self.leave_scene(&mut path, strategy);

@@ -39,7 +39,7 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-use crate::accel::{Ray, SceneAccel, SceneView, TopLevel};
+use crate::accel::{Ray, SceneAccel, TopLevel};
 use crate::scene::{Camera, Scene};
 use batches::{Batches, Bounds};
 use guiding::{Guide, guiding_at};
@@ -146,18 +146,12 @@ pub enum EarlyEnd {
 /// Makes the image of the samples taken so far, for a checkpoint.
 pub type ImageSoFar<'a> = &'a dyn Fn() -> (Image, RenderStats);
 
-/// Camera rays per triangle of the scene below which the grid of the camera's eye is not
-/// built ([`Renderer::eye_grid`]).
-const EYE_RAYS_PER_TRIANGLE: u64 = 8;
-
 /// How a pixel's camera rays are made: the camera, the pixel filter, and whether a
 /// shutter time is drawn.
 pub(crate) struct CameraSampling {
     generator: RayGenerator,
     filter: PixelFilter,
     timed: bool,
-    /// The grid of the camera's eye, when it has one ([`Renderer::eye_grid`]).
-    eye: Option<SceneView>,
 }
 
 impl CameraSampling {
@@ -174,11 +168,6 @@ impl CameraSampling {
         let time = if self.timed { sampler.uniform() } else { 0.0 };
         let (px, py) = (x as f32 + at.x, y as f32 + at.y);
         self.generator.generate_through_lens(px, py, lens, time)
-    }
-
-    /// The grid of the camera's eye, if it has one.
-    pub(crate) fn eye(&self) -> Option<&SceneView> {
-        self.eye.as_ref()
     }
 }
 
@@ -272,16 +261,10 @@ impl<'a> Renderer<'a> {
         on_pass: &mut dyn FnMut(u32, ImageSoFar),
     ) -> (Image, RenderStats) {
         let start = Instant::now();
-        let generator = RayGenerator::new(camera, settings.width, settings.height);
-        let filter = PixelFilter::new(settings.filter, settings.filter_width);
-        let timed = camera.motion.is_some() || self.scene.has_moving_geometry();
         let view = CameraSampling {
-            eye: (!timed)
-                .then(|| self.eye_grid(&generator, &filter, settings))
-                .flatten(),
-            generator,
-            filter,
-            timed,
+            generator: RayGenerator::new(camera, settings.width, settings.height),
+            filter: PixelFilter::new(settings.filter, settings.filter_width),
+            timed: camera.motion.is_some() || self.scene.has_moving_geometry(),
         };
         let first_sample = settings.samples.start;
         let spp = settings.spp().max(1);
@@ -332,7 +315,6 @@ impl<'a> Renderer<'a> {
                 want_features: film.wants_features(),
                 guiding,
                 next_event,
-                eye: view.eye(),
             };
             let (rays, samples) = self.sweep(
                 &mut film,
@@ -371,30 +353,6 @@ impl<'a> Renderer<'a> {
             on_pass(stats.spp, &|| image_so_far(&film, stats));
         }
         image_so_far(&film, stats)
-    }
-
-    /// The grid of a still pinhole camera's eye ([`SceneView`]), when the image has enough
-    /// camera rays to repay its build: about 0.4 µs per triangle against about 0.1 µs saved
-    /// per camera ray on the full dragon (`cargo bench --bench accel`, rows `view-camera`),
-    /// so at least [`EYE_RAYS_PER_TRIANGLE`] camera rays per triangle. Four columns per pixel:
-    /// a column a pixel wide holds a few dozen of a detailed mesh's triangles.
-    fn eye_grid(
-        &self,
-        generator: &RayGenerator,
-        filter: &PixelFilter,
-        settings: &RenderSettings,
-    ) -> Option<SceneView> {
-        let pixels = settings.width as u64 * settings.height as u64;
-        let camera_rays = pixels * settings.spp() as u64;
-        let triangles: u64 = (self.scene.instances.iter())
-            .map(|i| self.scene.meshes[i.mesh].indices.len() as u64)
-            .sum();
-        if camera_rays < EYE_RAYS_PER_TRIANGLE * triangles {
-            return None;
-        }
-        let columns = (4 * pixels).min(u32::MAX as u64) as u32;
-        let view = generator.view(filter.support(), columns)?;
-        SceneView::build(&self.accel, view)
     }
 
     /// Takes samples `samples` (with the seed before them) of every active pixel of `film`,
@@ -452,7 +410,6 @@ mod tests {
             generator: RayGenerator::new(&scene.cameras[0], width, height),
             filter: PixelFilter::new(FilterKind::Box, 1.0),
             timed: false,
-            eye: None,
         };
         let options = PathOptions::plain(16, Strategy::Mis);
         let fill = |batches: &[u32]| {
@@ -474,57 +431,5 @@ mod tests {
         assert_eq!(one_by_one.alpha, batched.alpha);
         assert_eq!(one_by_one.aovs, batched.aovs);
         assert!(one_by_one.pixels.iter().any(|p| p.max_element() > 0.0));
-    }
-
-    /// Paths whose first ray the grid of the camera's eye answers fill the film exactly as
-    /// paths that ask the scene's grids: the same sums, bit for bit, features and all, for
-    /// the bundled scenes with a pixel filter that reaches past the image.
-    #[test]
-    fn the_grid_of_the_eye_gives_the_image_the_scene_gives() {
-        for name in ["cornell_box.glb", "cornell_spheres.glb"] {
-            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("assets")
-                .join(name);
-            let scene = load_scene(&path).expect("the bundled scene loads").scene;
-            let renderer = Renderer::new(&scene);
-            let (width, height) = (40, 30);
-            let generator = RayGenerator::new(&scene.cameras[0], width, height);
-            let filter = PixelFilter::new(FilterKind::Gaussian, 1.5);
-            let window = generator.view(filter.support(), 4 * width * height);
-            let eye = SceneView::build(renderer.accel(), window.expect("a pinhole camera"));
-            let eye = eye.expect("still meshes in world space");
-            let answered = (0..height * width)
-                .filter(|i| {
-                    let ray = generator.generate((i % width) as f32, (i / width) as f32);
-                    eye.grid().intersect(&ray).is_some()
-                })
-                .count();
-            assert_eq!(
-                answered,
-                (width * height) as usize,
-                "{name}: rays outside the window"
-            );
-            let view = CameraSampling {
-                generator,
-                filter,
-                timed: false,
-                eye: Some(eye),
-            };
-            let fill = |eye| {
-                let mut film = Film::new(width, height, 0, AovSet::ALL, true);
-                let options = PathOptions {
-                    want_features: true,
-                    eye,
-                    ..PathOptions::plain(16, Strategy::Mis)
-                };
-                renderer.sweep(&mut film, &view, (3, 0..4), options, &|| {});
-                film.resolve(4).0
-            };
-            let (by_scene, by_eye) = (fill(None), fill(view.eye()));
-            assert_eq!(by_scene.pixels, by_eye.pixels, "{name}");
-            assert_eq!(by_scene.alpha, by_eye.alpha, "{name}");
-            assert_eq!(by_scene.aovs, by_eye.aovs, "{name}");
-            assert!(by_scene.pixels.iter().any(|p| p.max_element() > 0.0));
-        }
     }
 }

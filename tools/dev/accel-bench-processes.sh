@@ -21,8 +21,9 @@ export LD_LIBRARY_PATH="$root/.embree4${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 cd "$root"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+# The benchmark's own executable (the build also lists the gridtrace binary's).
 built=$(cargo bench --bench accel --no-run --quiet --message-format=json |
-  sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -n 1)
+  sed -n 's/.*"executable":"\([^"]*\/deps\/accel-[^"]*\)".*/\1/p' | tail -n 1)
 [ -x "$built" ] || {
   echo "accel-bench-processes: could not find the built benchmark" >&2
   exit 1

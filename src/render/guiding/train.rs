@@ -70,7 +70,6 @@ impl Renderer<'_> {
                         want_features: false,
                         guiding: PathGuiding::Train(guide),
                         next_event,
-                        eye: view.eye(),
                     };
                     self.trace_path_with(ray, &mut sampler, options);
                 }
