@@ -4,9 +4,10 @@
 //! Every ray from the eye is one point of the plane one unit ahead of it, so the grid is a
 //! 2D array of columns over a window of that plane; a triangle goes into each column its
 //! projection's bounds (with a margin for rounding) meet, and a column's triangles are kept
-//! nearest first, the columns one after another in blocks of eight. A ray finds its column with a division and two
-//! multiplications, then tests the column's blocks until the next block's least depth lies
-//! beyond the nearest hit found: no walk, and a ray that misses everything reads one word.
+//! nearest first, the columns one after another in blocks of eight. A ray finds its column
+//! with a division and two multiplications, then tests the column's blocks until the next
+//! block's least depth lies beyond the nearest hit found: no walk, and a ray that misses
+//! everything reads one word.
 //! The triangles are the grids' own (the numbers their blocks hold, tested by the same
 //! [`Block`] arithmetic), so a ray finds the hit the grids find: the same triangle, `t`,
 //! `u` and `v`, but for two triangles hit at exactly the same distance, where the order
@@ -55,7 +56,7 @@ pub struct View {
     pub lo: Vec2,
     /// The window's upper corner.
     pub hi: Vec2,
-    /// Columns wanted at most (no use finer than the image's pixels).
+    /// Columns wanted at most.
     pub max_columns: u32,
 }
 
@@ -158,7 +159,7 @@ impl ViewGrid {
         let near = fill_blocks(near_ids.iter().map(|&i| (&triangles[i as usize].0, i)));
         let (starts, blocks, depths) = fill_columns(&triangles, &places, &ranges, columns);
         Some(ViewGrid {
-            scale: columns.as_vec2() / (view.hi - view.lo),
+            scale: scale_of(&view, columns),
             view,
             columns,
             starts,
@@ -167,11 +168,6 @@ impl ViewGrid {
             near,
             owners,
         })
-    }
-
-    /// The view the grid is of.
-    pub fn view(&self) -> &View {
-        &self.view
     }
 
     /// Columns across and down.
@@ -260,6 +256,12 @@ impl ViewGrid {
     }
 }
 
+/// Columns per unit of `view`'s plane. One formula for the build and the query, so that a
+/// ray and the bounds of the triangles it meets map to columns alike ([`column_at`]).
+fn scale_of(view: &View, columns: UVec2) -> Vec2 {
+    columns.as_vec2() / (view.hi - view.lo)
+}
+
 /// The column holding plane point `p` (within the window, whose lower corner is `lo`).
 /// Rising in `p`, so a point within bounds lies in a column within the bounds' columns.
 #[inline(always)]
@@ -319,7 +321,7 @@ fn column_range(view: &View, columns: UVec2, place: &Place) -> Option<[UVec2; 2]
     let Place::Columns { lo, hi, .. } = place else {
         return None;
     };
-    let scale = columns.as_vec2() / (view.hi - view.lo);
+    let scale = scale_of(view, columns);
     Some([
         column_at(*lo, view.lo, scale, columns),
         column_at(*hi, view.lo, scale, columns),
