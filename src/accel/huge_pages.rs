@@ -16,6 +16,14 @@ pub(crate) fn vec_with_capacity<T>(capacity: usize) -> Vec<T> {
     v
 }
 
+/// `len` copies of `value`, on huge pages where the system offers them: for the build's
+/// large working arrays, whose first writes would otherwise fault once per 4 KiB page.
+pub(crate) fn filled<T: Clone>(len: usize, value: T) -> Vec<T> {
+    let mut v = vec_with_capacity(len);
+    v.resize(len, value);
+    v
+}
+
 /// Advises the whole 2 MiB pages within `bytes` bytes from `start` (madvise needs
 /// page-aligned ranges) to be huge pages.
 #[cfg(target_os = "linux")]

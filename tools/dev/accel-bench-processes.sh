@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs the accelerator benchmark (benches/accel.rs) in several fresh processes and prints,
 # per model and ray set, the grid/Embree median of each process and the median and range
-# over the processes.
+# over the processes; then the same for the build times.
 #
 #   tools/dev/accel-bench-processes.sh [PROCESSES]      (default 7)
 #
@@ -32,6 +32,7 @@ cp "$built" "$work/accel"
 echo "accel-bench-processes: $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src benches tests/support/oracles Cargo.toml Cargo.lock || echo ' with uncommitted changes'), built once" >&2
 rows=$work/rows
 warm=$work/warm
+builds=$work/builds
 for ((p = 1; p <= processes; p++)); do
   echo "accel-bench-processes: process $p of $processes" >&2
   # Table rows: | model | triangles | set | grid | Embree | CWBVH | grid/Embree median (range) | ...
@@ -43,6 +44,9 @@ for ((p = 1; p <= processes; p++)); do
   # warm time over the grid's, each ray traced several times in a row (computation alone).
   sed -n 's/^\([^,]*\), \([a-z]*\) rays, ns per ray cold \/ warm[^:]*: grid [0-9.]* \/ \([0-9.]*\), Embree [0-9.]* \/ \([0-9.]*\),.*/\1 \2 \3 \4/p' \
     "$work/out" | awk -v p="$p" '{ printf "%d %s %s %.2f\n", p, $1, $2, $4 / $3 }' >> "$warm"
+  # "MODEL: build s grid G, Embree E, ...": the grid's build time over Embree's.
+  sed -n 's/^\([^:]*\): build s grid \([0-9.]*\), Embree \([0-9.]*\),.*/\1 \2 \3/p' "$work/out" |
+    awk -v p="$p" '{ printf "%d %s build %.2f %s\n", p, $1, $2 / $3, $3 }' >> "$builds"
 done
 # Prints a table of the rows in file $1: per model and set, the values of each process, their
 # median and range, and each process's speed ($2 and $3 head the columns).
@@ -69,3 +73,6 @@ echo
 echo "Warm (each ray traced several times in a row: the computation alone, memory aside):"
 awk '{ print $1, $2, $3, $4, "-" }' "$warm" > "$work/warm_rows"
 report "$work/warm_rows" "Embree/grid warm ns per ray, each process" "-"
+echo
+echo "Build (median of five builds in each process; below 1 the grid builds faster):"
+report "$builds" "grid/Embree build time, each process" "Embree build s of each process"

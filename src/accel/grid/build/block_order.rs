@@ -1,7 +1,8 @@
-//! The triangles of each crowded cell of a grid that keeps boxes ([`crate::accel::grid::storage::cell_box`]) in
-//! Morton order of where they lie in the cell, so that each block's eight triangles lie near
-//! each other and its box is small: the walk then tests only the blocks whose boxes the ray
-//! meets, and asks memory for only those.
+//! The order of the triangles of each crowded cell of a grid that keeps boxes
+//! ([`crate::accel::grid::storage::cell_box`]): Morton order of where they lie in the cell,
+//! so that each block's eight triangles lie near each other and its box is small: the walk
+//! then tests only the blocks whose boxes the ray meets, and asks memory for only those.
+//! [`super::cell_blocks`] orders each cell's triangles as it writes the cell's blocks.
 //!
 //! The key of a triangle is the Morton code (Morton 1966; bits of the three axes
 //! interleaved) of the centre of its bounds clamped to the cell, at 16 steps a cell per
@@ -11,47 +12,15 @@
 //! without them (measured at 6d13fe3; docs/design/grid.md).
 
 use glam::{IVec3, UVec3, Vec3};
-use rayon::prelude::*;
 
-use crate::accel::grid::build::mesh_triangles::MeshTriangles;
 use crate::accel::grid::frame::GridFrame;
 use crate::geometry::Aabb;
 
 /// Steps per cell along each axis of the key (4 bits).
 const STEPS: f32 = 16.0;
 
-/// A run of `sorted`: the cell's triangles from `start`, `count` of them.
-pub(in crate::accel::grid) type CellRun = (u32, u32, IVec3);
-
-/// Puts the triangles of each of `runs` (cells, in the order of their runs in `sorted`, that
-/// do not overlap) in Morton order within its cell.
-pub(in crate::accel::grid) fn order_cells(
-    frame: &GridFrame,
-    sorted: &mut [u32],
-    runs: &[CellRun],
-    triangles: MeshTriangles,
-) {
-    let mut pieces = Vec::with_capacity(runs.len());
-    let (mut rest, mut at) = (sorted, 0usize);
-    for &(start, count, cell) in runs {
-        let (_, tail) = std::mem::take(&mut rest).split_at_mut(start as usize - at);
-        let (piece, tail) = tail.split_at_mut(count as usize);
-        pieces.push((piece, cell));
-        (rest, at) = (tail, (start + count) as usize);
-    }
-    pieces.into_par_iter().for_each(|(piece, cell)| {
-        let mut keyed: Vec<(u32, u32)> = piece
-            .iter()
-            .map(|&t| (key(frame, cell, triangles.get(t).bounds()), t))
-            .collect();
-        keyed.sort_unstable();
-        for (slot, (_, t)) in piece.iter_mut().zip(keyed) {
-            *slot = t;
-        }
-    });
-}
-
 /// The Morton code of the centre of `bounds` clamped to cell `cell`.
+#[inline(always)]
 pub(in crate::accel::grid) fn key(frame: &GridFrame, cell: IVec3, bounds: Aabb) -> u32 {
     let corner = frame.bounds.min + cell.as_vec3() * frame.cell_size;
     let lo = bounds.min.max(corner);
@@ -62,6 +31,7 @@ pub(in crate::accel::grid) fn key(frame: &GridFrame, cell: IVec3, bounds: Aabb) 
 }
 
 /// The bits of the three 4-bit coordinates interleaved, x lowest.
+#[inline(always)]
 fn interleave(c: UVec3) -> u32 {
     (0..4).fold(0, |code, bit| {
         code | ((c.x >> bit) & 1) << (3 * bit)

@@ -6,6 +6,8 @@
 use glam::IVec3;
 use rayon::prelude::*;
 
+use crate::accel::huge_pages;
+
 /// Occupied cells per box of a grid of `resolution` cells.
 pub(in crate::accel::grid) struct BoxCounts {
     resolution: IVec3,
@@ -21,7 +23,7 @@ impl BoxCounts {
     pub fn new(resolution: IVec3, occupied: impl Fn(IVec3) -> bool + Sync) -> BoxCounts {
         let (sx, sy) = (resolution.x as usize + 1, resolution.y as usize + 1);
         let plane = sx * sy;
-        let mut sums = vec![0u32; plane * (resolution.z as usize + 1)];
+        let mut sums = huge_pages::filled(plane * (resolution.z as usize + 1), 0u32);
         // Along x, then y, within each plane of constant z (the first plane stays 0).
         sums.par_chunks_mut(plane)
             .skip(1)

@@ -11,6 +11,7 @@
 use rayon::prelude::*;
 
 use crate::accel::grid::storage::macrocell::MACRO_CELLS;
+use crate::accel::huge_pages;
 
 /// Parts the keys are cut into, at most: enough for two threads to share the work evenly
 /// however the occupied macrocells cluster, few enough that a chunk's buckets stay small.
@@ -62,7 +63,7 @@ impl KeyParts {
     /// Sorts the pairs of `chunks` (in triangle order) into cell order over `keys` keys.
     pub fn sort(&self, chunks: &[Buckets], keys: usize) -> CellOrder {
         let pairs_of = |part: usize| chunks.iter().flat_map(move |c| &c[part]);
-        let mut counts = vec![0u32; keys];
+        let mut counts = huge_pages::filled(keys, 0u32);
         let in_part: Vec<usize> = counts
             .par_chunks_mut(self.part_keys)
             .enumerate()
@@ -76,7 +77,7 @@ impl KeyParts {
                 n
             })
             .collect();
-        let mut sorted = vec![0u32; in_part.iter().sum()];
+        let mut sorted = huge_pages::filled(in_part.iter().sum(), 0u32);
         let mut slices = Vec::with_capacity(in_part.len());
         let mut rest = sorted.as_mut_slice();
         for &n in &in_part {
@@ -89,9 +90,9 @@ impl KeyParts {
             .into_par_iter()
             .zip(counts.par_chunks(self.part_keys))
             .enumerate()
-            .for_each(|(part, (slice, counts))| {
+            .for_each_init(Vec::new, |next, (part, (slice, counts))| {
                 let first = part * self.part_keys;
-                let mut next = Vec::with_capacity(counts.len());
+                next.clear();
                 let mut start = 0u32;
                 for &n in counts {
                     next.push(start);
@@ -139,7 +140,7 @@ mod tests {
                 expected.iter().map(|p| p.1).collect::<Vec<_>>(),
                 "{macrocells} macrocells"
             );
-            let mut counts = vec![0u32; keys];
+            let mut counts = huge_pages::filled(keys, 0u32);
             for &(key, _) in &expected {
                 counts[key as usize] += 1;
             }

@@ -18,6 +18,7 @@ use rayon::prelude::*;
 
 use crate::accel::grid::build::mesh_triangles::MeshTriangles;
 use crate::accel::grid::frame::{GridFrame, resolution};
+use crate::accel::huge_pages;
 use crate::geometry::Aabb;
 
 /// λ for evenly spread triangles (the Stanford dragons of 11k and 203k triangles: 1.02–1.10×
@@ -65,7 +66,8 @@ pub(in crate::accel::grid) fn crowding(
         bounds,
         resolution(bounds.extent(), live.len(), EVEN_DENSITY),
     );
-    let counts: Vec<AtomicU32> = (0..frame.cell_count()).map(|_| AtomicU32::new(0)).collect();
+    let mut counts: Vec<AtomicU32> = huge_pages::vec_with_capacity(frame.cell_count());
+    counts.extend((0..frame.cell_count()).map(|_| AtomicU32::new(0)));
     live.par_iter().for_each(|&t| {
         let triangle = triangles.get(t);
         let centroid = triangle.v0 + (triangle.e1 + triangle.e2) / 3.0;

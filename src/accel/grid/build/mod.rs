@@ -2,12 +2,13 @@
 
 pub(in crate::accel::grid) mod block_order;
 pub(in crate::accel::grid) mod box_counts;
+pub(in crate::accel::grid) mod cell_blocks;
 pub(in crate::accel::grid) mod cell_order;
 pub(in crate::accel::grid) mod density;
 pub(in crate::accel::grid) mod mesh_triangles;
 pub(in crate::accel::grid) mod overlap;
 
-use glam::{IVec3, UVec3, Vec3};
+use glam::{UVec3, Vec3};
 use rayon::prelude::*;
 
 use super::Grid;
@@ -15,15 +16,15 @@ use crate::accel::grid::storage::block::{Block, LANES};
 use crate::accel::grid::storage::cell_box::{self, Kept};
 use crate::accel::grid::storage::cells::CellIndex;
 use crate::accel::grid::storage::macrocell::MACRO_CELLS;
-use block_order::CellRun;
+use cell_blocks::{BlockBoxes, CellRun};
 use cell_order::{Buckets, CellOrder, KeyParts};
 use mesh_triangles::MeshTriangles;
 use overlap::{Polygon, TriangleBoxTest};
 
+use crate::accel::Triangle;
 use crate::accel::grid::frame::{GridFrame, padded, resolution};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::isa::{Kernel, X86Level, dispatch};
-use crate::accel::{Triangle, huge_pages};
 use crate::geometry::Aabb;
 
 /// Which grids keep boxes per cell and per block ([`cell_box`]).
@@ -158,9 +159,9 @@ impl Grid {
     /// Fills the compact storage: the overlap tests run once, in parallel over chunks of
     /// triangles, giving (cell, triangle) pairs in triangle order; a counting sort by cell
     /// ([`cell_order`], in parallel over parts of the grid) lays them out in cell order, and
-    /// the blocks are then written in parallel, each from its run of that list, straight
-    /// into their final place (no pass over the whole block array before it is filled).
-    /// Within a cell, triangles keep mesh order (in a grid that keeps boxes per block, Morton
+    /// the blocks are then written cell by cell, in parallel, straight into their final place
+    /// ([`cell_blocks`]; no pass over the whole block array before it is filled), while the
+    /// index is built. Within a cell, triangles keep mesh order (in a grid that keeps boxes per block, Morton
     /// order with ties in mesh order, [`block_order`]) whatever the thread count, so ties
     /// between equal hits resolve the same way. False, with nothing changed, if there are more
     /// references than 32-bit offsets hold.
@@ -176,63 +177,39 @@ impl Grid {
         if references >= u32::MAX as usize && self.frame.resolution != UVec3::ONE {
             return false;
         }
-        let CellOrder { counts, mut sorted } = parts.sort(&chunks, keys);
+        let CellOrder { counts, sorted } = parts.sort(&chunks, keys);
         drop(chunks);
-        let cells = CellIndex::build(
-            self.frame.resolution,
-            &counts,
-            LANES as u32,
-            std::mem::size_of::<Block>(),
-        );
-        // Each block's run of the sorted triangle numbers (start, length), in key order as
-        // the index numbers them (empty macrocells, most of the grid, are passed over
-        // whole).
-        let mut runs: Vec<(u32, u32, IVec3)> = Vec::with_capacity(cells.block_count());
+        let runs = cell_runs(m, &counts);
+        let block_count: usize = runs.iter().map(CellRun::blocks).sum();
         // Boxes per cell and per block ([`cell_box`]) for a grid whose blocks outgrow the
         // caches, each block's found as it is written, while its triangles are at hand; the
         // triangles of its cells of more than one block in Morton order ([`block_order`]).
         let kept = match boxes {
-            Boxes::BySize => {
-                cell_box::boxes_for(cells.block_count() * std::mem::size_of::<Block>())
-            }
+            Boxes::BySize => cell_box::boxes_for(block_count * std::mem::size_of::<Block>()),
             Boxes::Always => Kept::CellsAndBlocks,
         };
         let margin = cell_box::margin_for(&self.frame).filter(|_| kept != Kept::None);
         let masked = margin.is_some() && kept == Kept::CellsAndBlocks;
-        let mut crowded: Vec<CellRun> = Vec::new();
-        let mut start = 0u32;
-        for (mi, macrocell) in counts.chunks(MACRO_CELLS).enumerate() {
-            if macrocell.iter().all(|&n| n == 0) {
-                continue;
-            }
-            for (l, &count) in macrocell.iter().enumerate().filter(|(_, n)| **n != 0) {
-                let cell = CellIndex::cell_at(m, mi, l);
-                for first in (0..count).step_by(LANES) {
-                    runs.push((start + first, (count - first).min(LANES as u32), cell));
-                }
-                if masked && count > LANES as u32 {
-                    crowded.push((start, count, cell));
-                }
-                start += count;
-            }
-        }
-        debug_assert_eq!(runs.len(), cells.block_count());
-        drop(counts);
-        block_order::order_cells(&self.frame, &mut sorted, &crowded, triangles);
-        drop(crowded);
-        let mut blocks: Vec<Block> = huge_pages::vec_with_capacity(runs.len());
-        let mut words: Vec<u32> = Vec::new();
-        let boxed = margin.is_some();
-        let block_of = |&run: &(u32, u32, IVec3)| self.block_of(run, &sorted, triangles, boxed);
-        if boxed {
-            runs.par_iter()
-                .map(block_of)
-                .unzip_into_vecs(&mut blocks, &mut words);
-        } else {
-            runs.par_iter()
-                .map(|run| block_of(run).0)
-                .collect_into_vec(&mut blocks);
-        }
+        let block_boxes = match (margin, masked) {
+            (None, _) => BlockBoxes::None,
+            (Some(_), false) => BlockBoxes::Words,
+            (Some(_), true) => BlockBoxes::OrderedWords,
+        };
+        // The index and the blocks depend only on the counts and the sorted triangles: each
+        // fills the other's idle moments.
+        let (cells, (blocks, words)) = rayon::join(
+            || {
+                CellIndex::build(
+                    self.frame.resolution,
+                    &counts,
+                    LANES as u32,
+                    std::mem::size_of::<Block>(),
+                )
+            },
+            || cell_blocks::write(&self.frame, &runs, &sorted, triangles, block_boxes),
+        );
+        debug_assert_eq!(blocks.len(), cells.block_count());
+        drop((runs, sorted, counts));
         self.cells = cells;
         self.blocks = blocks;
         self.references = references;
@@ -279,46 +256,6 @@ impl Grid {
                 cell_box::join_all(&[cell_box::triangles_word(&self.frame, c, triangles)])
             })
             .collect()
-    }
-
-    /// The block of `run` (the start and length of its triangles in `sorted`, and its
-    /// cell), and if `boxed` the word of its triangles' box within the cell ([`cell_box`]).
-    fn block_of(
-        &self,
-        run: (u32, u32, IVec3),
-        sorted: &[u32],
-        triangles: MeshTriangles,
-        boxed: bool,
-    ) -> (Block, u32) {
-        let work = BlockOf {
-            grid: self,
-            run,
-            sorted,
-            triangles,
-            boxed,
-        };
-        dispatch(X86Level::Avx2, work)
-    }
-
-    #[inline(always)]
-    fn block_of_portable(
-        &self,
-        (start, length, cell): (u32, u32, IVec3),
-        sorted: &[u32],
-        triangles: MeshTriangles,
-        boxed: bool,
-    ) -> (Block, u32) {
-        let mut block = Block::EMPTY;
-        let run = &sorted[start as usize..(start + length) as usize];
-        for (lane, &t) in run.iter().enumerate() {
-            block.set(lane, &triangles.get(t), t);
-        }
-        let word = if boxed {
-            cell_box::block_word(&self.frame, cell, &block)
-        } else {
-            0
-        };
-        (block, word)
     }
 
     /// The (cell, triangle) pairs of the live triangles numbered in `chunk`, in triangle
@@ -434,6 +371,25 @@ pub(in crate::accel::grid) fn soup(triangles: &[Triangle]) -> (Vec<Vec3>, Vec<[u
     (vertices, indices)
 }
 
+/// The occupied cells' runs of the cell-sorted triangle numbers, in key order as the index
+/// numbers them, from the triangles per key `counts` (empty macrocells, most of the grid,
+/// are passed over whole).
+fn cell_runs(m: UVec3, counts: &[u32]) -> Vec<CellRun> {
+    let mut runs = Vec::new();
+    let mut start = 0u32;
+    for (mi, macrocell) in counts.chunks(MACRO_CELLS).enumerate() {
+        if macrocell.iter().all(|&n| n == 0) {
+            continue;
+        }
+        for (l, &count) in macrocell.iter().enumerate().filter(|(_, n)| **n != 0) {
+            let cell = CellIndex::cell_at(m, mi, l);
+            runs.push(CellRun { start, count, cell });
+            start += count;
+        }
+    }
+    runs
+}
+
 /// Most references (cell, triangle pairs) the build may make per triangle on average, and in
 /// all: long thin triangles across a fine grid (a fan of 100k slivers) would otherwise
 /// make hundreds each, and more than 2^32 would overflow the offsets.
@@ -520,25 +476,6 @@ impl Sizes {
         self.area += other.area;
         self.perimeter += other.perimeter;
         self.count += other.count;
-    }
-}
-
-/// [`Grid::block_of_portable`] as a [`Kernel`]: compiled for AVX2 like the overlap tests
-/// (the arithmetic, and so the grid, is the same).
-struct BlockOf<'a> {
-    grid: &'a Grid,
-    run: (u32, u32, IVec3),
-    sorted: &'a [u32],
-    triangles: MeshTriangles<'a>,
-    boxed: bool,
-}
-
-impl Kernel for BlockOf<'_> {
-    type Output = (Block, u32);
-    #[inline(always)]
-    fn run<const FUSED: bool>(self) -> (Block, u32) {
-        self.grid
-            .block_of_portable(self.run, self.sorted, self.triangles, self.boxed)
     }
 }
 
@@ -634,21 +571,25 @@ mod tests {
         let cells = grid.cells.occupied_cells();
         let (mut partial, mut blocks) = (0, 0);
         for (k, &cell) in cells.iter().enumerate() {
-            let mut words = Vec::new();
-            for block in &grid.blocks[grid.cells.blocks_of(k)] {
-                let ids: Vec<u32> = (0..LANES)
-                    .filter_map(|l| block.get(l))
-                    .map(|(_, t)| t)
-                    .collect();
-                let run = (0, ids.len() as u32, cell);
-                let (fast, word) = grid.block_of(run, &ids, mesh, true);
-                assert_eq!(&fast, block);
-                assert_eq!(grid.block_of_portable(run, &ids, mesh, true), (fast, word));
-                words.push(word);
-                blocks += 1;
-            }
-            assert_eq!(cell_box::join_all(&words), expected[k], "cell {cell}");
+            let stored = &grid.blocks[grid.cells.blocks_of(k)];
+            let ids: Vec<u32> = stored
+                .iter()
+                .flat_map(|block| (0..LANES).filter_map(|l| block.get(l)).map(|(_, t)| t))
+                .collect();
+            let run = CellRun {
+                start: 0,
+                count: ids.len() as u32,
+                cell,
+            };
+            let fast = cell_blocks::write_cell(&grid.frame, run, &ids, mesh, false);
+            assert_eq!(fast.0, stored);
+            assert_eq!(
+                cell_blocks::write_cell(&grid.frame, run, &ids, mesh, true),
+                fast
+            );
+            assert_eq!(cell_box::join_all(&fast.1), expected[k], "cell {cell}");
             partial += usize::from(expected[k] != cell_box::WHOLE);
+            blocks += stored.len();
         }
         // Most boxes are smaller than their cells, and many cells have several blocks.
         assert!(
