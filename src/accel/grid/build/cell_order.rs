@@ -140,7 +140,7 @@ mod tests {
                 expected.iter().map(|p| p.1).collect::<Vec<_>>(),
                 "{macrocells} macrocells"
             );
-            let mut counts = huge_pages::filled(keys, 0u32);
+            let mut counts = vec![0u32; keys];
             for &(key, _) in &expected {
                 counts[key as usize] += 1;
             }

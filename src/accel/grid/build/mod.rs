@@ -161,10 +161,10 @@ impl Grid {
     /// ([`cell_order`], in parallel over parts of the grid) lays them out in cell order, and
     /// the blocks are then written cell by cell, in parallel, straight into their final place
     /// ([`cell_blocks`]; no pass over the whole block array before it is filled), while the
-    /// index is built. Within a cell, triangles keep mesh order (in a grid that keeps boxes per block, Morton
-    /// order with ties in mesh order, [`block_order`]) whatever the thread count, so ties
-    /// between equal hits resolve the same way. False, with nothing changed, if there are more
-    /// references than 32-bit offsets hold.
+    /// index is built. Within a cell, triangles keep mesh order (in a grid that keeps boxes
+    /// per block, Morton order with ties in mesh order, [`block_order`]) whatever the thread
+    /// count, so ties between equal hits resolve the same way. False, with nothing changed,
+    /// if there are more references than 32-bit offsets hold.
     fn insert(&mut self, triangles: MeshTriangles, live: &[u32], boxes: Boxes) -> bool {
         let m = CellIndex::macro_resolution_for(self.frame.resolution);
         let keys = (m.x * m.y * m.z) as usize * MACRO_CELLS;
