@@ -44,43 +44,57 @@ impl BoxCounts {
                     }
                 }
             });
-        // Along z.
-        for z in 1..resolution.z as usize + 1 {
-            let (before, rest) = sums.split_at_mut(plane * z);
-            for (sum, below) in rest[..plane].iter_mut().zip(&before[plane * (z - 1)..]) {
-                *sum = sum.wrapping_add(*below);
+        // Along z, in parallel over runs of each plane (a run's column of planes is summed
+        // apart from the others).
+        const RUN: usize = 4096;
+        let mut columns: Vec<Vec<&mut [u32]>> =
+            (0..plane.div_ceil(RUN)).map(|_| Vec::new()).collect();
+        for plane_sums in sums.chunks_mut(plane) {
+            for (column, run) in columns.iter_mut().zip(plane_sums.chunks_mut(RUN)) {
+                column.push(run);
             }
         }
+        columns.into_par_iter().for_each(|mut column| {
+            for z in 1..column.len() {
+                let (below, rest) = column.split_at_mut(z);
+                for (sum, below) in rest[0].iter_mut().zip(below[z - 1].iter()) {
+                    *sum = sum.wrapping_add(*below);
+                }
+            }
+        });
         BoxCounts { resolution, sums }
     }
 
-    fn index(&self, x: i32, y: i32, z: i32) -> usize {
-        let (sx, sy) = (
-            self.resolution.x as usize + 1,
-            self.resolution.y as usize + 1,
-        );
-        x as usize + sx * (y as usize + sy * z as usize)
-    }
-
-    fn sum(&self, x: i32, y: i32, z: i32) -> u32 {
-        self.sums[self.index(x, y, z)]
+    /// Cells along each axis of the grid.
+    pub fn resolution(&self) -> IVec3 {
+        self.resolution
     }
 
     /// Occupied cells in the box `lo..=hi`, clipped to the grid.
+    #[inline]
     pub fn count(&self, lo: IVec3, hi: IVec3) -> u32 {
         let lo = lo.max(IVec3::ZERO);
         let hi = (hi + 1).min(self.resolution);
         if lo.cmpge(hi).any() {
             return 0;
         }
-        self.sum(hi.x, hi.y, hi.z)
-            .wrapping_sub(self.sum(lo.x, hi.y, hi.z))
-            .wrapping_sub(self.sum(hi.x, lo.y, hi.z))
-            .wrapping_sub(self.sum(hi.x, hi.y, lo.z))
-            .wrapping_add(self.sum(lo.x, lo.y, hi.z))
-            .wrapping_add(self.sum(lo.x, hi.y, lo.z))
-            .wrapping_add(self.sum(hi.x, lo.y, lo.z))
-            .wrapping_sub(self.sum(lo.x, lo.y, lo.z))
+        // Offsets of the box's two x, y and z planes in the table.
+        let (sx, sy) = (
+            self.resolution.x as usize + 1,
+            self.resolution.y as usize + 1,
+        );
+        let (x0, x1) = (lo.x as usize, hi.x as usize);
+        let (y0, y1) = (sx * lo.y as usize, sx * hi.y as usize);
+        let (z0, z1) = (sx * sy * lo.z as usize, sx * sy * hi.z as usize);
+        let sum = |x: usize, y: usize, z: usize| self.sums[x + y + z];
+        sum(x1, y1, z1)
+            .wrapping_sub(sum(x0, y1, z1))
+            .wrapping_sub(sum(x1, y0, z1))
+            .wrapping_sub(sum(x1, y1, z0))
+            .wrapping_add(sum(x0, y0, z1))
+            .wrapping_add(sum(x0, y1, z0))
+            .wrapping_add(sum(x1, y0, z0))
+            .wrapping_sub(sum(x0, y0, z0))
     }
 }
 

@@ -95,10 +95,12 @@ pub(in crate::accel::grid) fn boxes(resolution: IVec3, cells: &BoxCounts) -> Vec
                 return packed;
             }
             for (octant, entry) in (0..8).zip(&mut packed) {
-                let side = largest(MACRO_SIDE, |s| empty(octant, IVec3::splat(s)));
-                let x = largest(side, |s| empty(octant, IVec3::new(s, side, side)));
-                let y = largest(side, |s| empty(octant, IVec3::new(x, s, side)));
-                let z = largest(side, |s| empty(octant, IVec3::new(x, y, s)));
+                let edge = edge_sides(cells.resolution(), corner, octant);
+                let cube = |s| empty(octant, IVec3::splat(s));
+                let side = largest(MACRO_SIDE, edge.max_element(), cube);
+                let x = largest(side, edge.x, |s| empty(octant, IVec3::new(s, side, side)));
+                let y = largest(side, edge.y, |s| empty(octant, IVec3::new(x, s, side)));
+                let z = largest(side, edge.z, |s| empty(octant, IVec3::new(x, y, s)));
                 *entry = pack(IVec3::new(x, y, z));
             }
             packed
@@ -106,10 +108,32 @@ pub(in crate::accel::grid) fn boxes(resolution: IVec3, cells: &BoxCounts) -> Vec
         .collect()
 }
 
-/// The largest side in `low..=MAX_SIDE` for which `fits` holds, by bisection: `fits(low)`
-/// holds, and a side for which it fails fails for every larger one (boxes nest).
-fn largest(low: i32, fits: impl Fn(i32) -> bool) -> i32 {
-    let (mut low, mut high) = (low, MAX_SIDE + 1);
+/// Per axis, the side from which a box with the macrocell at `corner` in its corner,
+/// extending towards `octant`, reaches the far edge of a grid of `resolution` cells: the
+/// boxes of that side and larger hold the same cells of the grid.
+fn edge_sides(resolution: IVec3, corner: IVec3, octant: u32) -> IVec3 {
+    IVec3::from_array([0, 1, 2].map(|a| match moves_up(octant, a) {
+        true => resolution[a] - corner[a],
+        false => corner[a] + MACRO_SIDE,
+    }))
+}
+
+/// The largest side in `low..=MAX_SIDE` for which `fits` holds: `fits(low)` holds, a side
+/// for which it fails fails for every larger one (boxes nest), and the sides from `edge` on
+/// hold the same cells (the box has reached the grid's edge). Two answers are tried first —
+/// the box reaches the edge, or does not grow (two fifths of the full dragon's searches) —
+/// then the rest by bisection between them: the full dragon's boxes in about half the
+/// time of a bisection over `low..=MAX_SIDE`.
+fn largest(low: i32, edge: i32, fits: impl Fn(i32) -> bool) -> i32 {
+    let edge = edge.min(MAX_SIDE);
+    if edge <= low || fits(edge) {
+        return MAX_SIDE;
+    }
+    if !fits(low + 1) {
+        return low;
+    }
+    // `fits(low)` holds and `fits(high)` fails.
+    let (mut low, mut high) = (low + 1, edge);
     while high - low > 1 {
         let mid = (low + high) / 2;
         if fits(mid) {
