@@ -13,15 +13,19 @@ use rayon::prelude::*;
 use crate::accel::grid::storage::macrocell::MACRO_CELLS;
 use crate::accel::huge_pages;
 
-/// Parts the keys are cut into, at most: enough for two threads to share the work evenly
-/// however the occupied macrocells cluster, few enough that a chunk's buckets stay small.
+/// Parts the keys are cut into, at most (at least half as many in a large grid): enough
+/// for two threads to share the work evenly however the occupied macrocells cluster, few
+/// enough that a chunk's buckets stay small.
 const MAX_PARTS: usize = 64;
 
 /// How the storage keys are cut into parts of whole macrocells.
 #[derive(Clone, Copy, Debug)]
 pub(in crate::accel::grid) struct KeyParts {
-    /// Keys per part (the last may have fewer).
+    /// Keys per part (the last may have fewer): a power of two, so that a key's part is a
+    /// shift away (a division by it was the overlap tests' costliest instruction).
     part_keys: usize,
+    /// log2 of `part_keys`.
+    part_shift: u32,
     /// Number of parts.
     parts: usize,
 }
@@ -42,9 +46,10 @@ impl KeyParts {
     /// The parts of `keys` storage keys (a whole number of macrocells).
     pub fn new(keys: usize) -> KeyParts {
         let macrocells = keys.div_ceil(MACRO_CELLS).max(1);
-        let part_keys = macrocells.div_ceil(MAX_PARTS) * MACRO_CELLS;
+        let part_keys = macrocells.div_ceil(MAX_PARTS).next_power_of_two() * MACRO_CELLS;
         KeyParts {
             part_keys,
+            part_shift: part_keys.trailing_zeros(),
             parts: keys.div_ceil(part_keys).max(1),
         }
     }
@@ -57,7 +62,7 @@ impl KeyParts {
     /// Puts the pair (`key`, `triangle`) into its part's bucket.
     #[inline]
     pub fn push(&self, buckets: &mut Buckets, key: usize, triangle: u32) {
-        buckets[key / self.part_keys].push((key as u32, triangle));
+        buckets[key >> self.part_shift].push((key as u32, triangle));
     }
 
     /// Sorts the pairs of `chunks` (in triangle order) into cell order over `keys` keys.

@@ -137,7 +137,9 @@ pub(in crate::accel::grid) fn triangles_word(
     word(frame, &cell, parts.fold(Aabb::EMPTY, Aabb::union))
 }
 
-/// The word of `part`, a box within `cell` ([`NOTHING`] if it is empty).
+/// The word of `part`, a box within `cell` ([`NOTHING`] if it is empty). Inlined, so that
+/// the block writer compiled for AVX2 rounds in one instruction rather than a call.
+#[inline(always)]
 fn word(frame: &GridFrame, cell: &CellBounds, part: Aabb) -> u32 {
     if part.min.cmpgt(part.max).any() {
         return NOTHING;
