@@ -17,10 +17,21 @@ pub(in crate::accel::grid) struct BoxCounts {
 }
 
 impl BoxCounts {
-    /// The table for a grid whose cell `c` is occupied when `occupied(c)`: the occupancy
-    /// summed along x, then y, then z, one axis at a time (each pass over rows or planes
-    /// that are independent, in parallel where they are).
+    /// The table for a grid whose cell `c` is occupied when `occupied(c)`.
     pub fn new(resolution: IVec3, occupied: impl Fn(IVec3) -> bool + Sync) -> BoxCounts {
+        BoxCounts::from_rows(resolution, |y, z, row| {
+            for (x, cell) in row.iter_mut().enumerate() {
+                *cell = occupied(IVec3::new(x as i32, y, z));
+            }
+        })
+    }
+
+    /// The table for a grid whose row of cells along x at `(y, z)` is occupied where
+    /// `row(y, z, occupied)` sets `occupied` (as long as the row, cleared) true: the
+    /// occupancy summed along x, then y, then z, one axis at a time (each pass over rows or
+    /// planes that are independent, in parallel where they are). A row at a time lets the
+    /// caller read its storage in runs instead of finding each cell's place.
+    pub fn from_rows(resolution: IVec3, row: impl Fn(i32, i32, &mut [bool]) + Sync) -> BoxCounts {
         let (sx, sy) = (resolution.x as usize + 1, resolution.y as usize + 1);
         let plane = sx * sy;
         let mut sums = huge_pages::filled(plane * (resolution.z as usize + 1), 0u32);
@@ -28,22 +39,27 @@ impl BoxCounts {
         sums.par_chunks_mut(plane)
             .skip(1)
             .enumerate()
-            .for_each(|(z, plane)| {
-                for y in 0..resolution.y {
-                    let row = &mut plane[sx * (y as usize + 1)..][..sx];
-                    let mut sum = 0;
-                    for x in 0..resolution.x {
-                        sum += u32::from(occupied(IVec3::new(x, y, z as i32)));
-                        row[x as usize + 1] = sum;
+            .for_each_init(
+                || vec![false; resolution.x as usize],
+                |occupied, (z, plane)| {
+                    for y in 0..resolution.y {
+                        occupied.fill(false);
+                        row(y, z as i32, occupied);
+                        let sums = &mut plane[sx * (y as usize + 1)..][..sx];
+                        let mut sum = 0;
+                        for (x, &cell) in occupied.iter().enumerate() {
+                            sum += u32::from(cell);
+                            sums[x + 1] = sum;
+                        }
                     }
-                }
-                for y in 1..sy {
-                    let (before, rest) = plane.split_at_mut(sx * y);
-                    for (sum, below) in rest[..sx].iter_mut().zip(&before[sx * (y - 1)..]) {
-                        *sum = sum.wrapping_add(*below);
+                    for y in 1..sy {
+                        let (before, rest) = plane.split_at_mut(sx * y);
+                        for (sum, below) in rest[..sx].iter_mut().zip(&before[sx * (y - 1)..]) {
+                            *sum = sum.wrapping_add(*below);
+                        }
                     }
-                }
-            });
+                },
+            );
         // Along z, in parallel over runs of each plane (a run's column of planes is summed
         // apart from the others).
         const RUN: usize = 4096;

@@ -164,8 +164,15 @@ impl CellIndex {
             ranks.push(first);
         }
         index.offsets.push(total);
-        let cells = BoxCounts::new(resolution.as_ivec3(), |c| {
-            triangles[CellIndex::storage_key(macro_resolution, c.as_uvec3())] > 0
+        // A row's cells lie in runs of eight in storage, one run per macrocell it crosses.
+        let cells = BoxCounts::from_rows(resolution.as_ivec3(), |y, z, row| {
+            for (mx, run) in row.chunks_mut(1 << MACRO_SHIFT).enumerate() {
+                let first = UVec3::new((mx as u32) << MACRO_SHIFT, y as u32, z as u32);
+                let key = CellIndex::storage_key(macro_resolution, first);
+                for (cell, &n) in run.iter_mut().zip(&triangles[key..]) {
+                    *cell = n > 0;
+                }
+            }
         });
         index.fill_entries(&cells, &record_of);
         index.first_cells = ranks.iter().map(|r| r[0]).collect();
