@@ -56,6 +56,13 @@ pub(in crate::accel::grid) enum BlockBoxes {
     OrderedWords,
 }
 
+impl BlockBoxes {
+    /// Box words written for `blocks` blocks: one per block, or none.
+    fn words_for(self, blocks: usize) -> usize {
+        if self == BlockBoxes::None { 0 } else { blocks }
+    }
+}
+
 /// The blocks of the cells `runs` (in the order the index numbers them) from the triangles
 /// `sorted` lists cell by cell, and the blocks' box words (empty for [`BlockBoxes::None`]).
 pub(in crate::accel::grid) fn write(
@@ -66,7 +73,7 @@ pub(in crate::accel::grid) fn write(
     boxes: BlockBoxes,
 ) -> (Vec<Block>, Vec<u32>) {
     let count: usize = runs.iter().map(CellRun::blocks).sum();
-    let words_count = if boxes == BlockBoxes::None { 0 } else { count };
+    let words_count = boxes.words_for(count);
     let mut blocks: Vec<Block> = huge_pages::vec_with_capacity(count);
     let mut words: Vec<u32> = Vec::with_capacity(words_count);
     // Each group of cells' own slots of both arrays, in order: together, the first `count`
@@ -79,8 +86,7 @@ pub(in crate::accel::grid) fn write(
         let n: usize = group.iter().map(CellRun::blocks).sum();
         let (own, rest) = std::mem::take(&mut block_slots).split_at_mut(n);
         block_slots = rest;
-        let worded = if boxes == BlockBoxes::None { 0 } else { n };
-        let (own_words, rest) = std::mem::take(&mut word_slots).split_at_mut(worded);
+        let (own_words, rest) = std::mem::take(&mut word_slots).split_at_mut(boxes.words_for(n));
         word_slots = rest;
         jobs.push((group, own, own_words));
     }
@@ -91,8 +97,7 @@ pub(in crate::accel::grid) fn write(
                 let n = run.blocks();
                 let (blocks, rest) = std::mem::take(&mut own).split_at_mut(n);
                 own = rest;
-                let worded = own_words.len().min(n);
-                let (words, rest) = std::mem::take(&mut own_words).split_at_mut(worded);
+                let (words, rest) = std::mem::take(&mut own_words).split_at_mut(boxes.words_for(n));
                 own_words = rest;
                 let cell = FillCell {
                     frame,
