@@ -25,6 +25,9 @@ use super::{Grid, GridHit, Ray, TraversalStats};
 use crate::geometry::Aabb;
 use crate::scene::{Motion, Scene, TimeSlice};
 
+mod eye;
+pub use eye::EyeGrid;
+
 /// Up to this many entries are tested one after another; past it, the instance grid
 /// visits only those near the ray (`cargo bench --bench instances`: at 11 instances the
 /// list was 10 % faster per ray, at 101 the grid twice as fast).

@@ -15,7 +15,7 @@ mod triangle;
 pub use grid::{
     Grid, GridHit, GridStats, TraversalCounts, TraversalStats, View, ViewGrid, ViewHit,
 };
-pub use instances::{SceneAccel, SceneHit, TopLevel};
+pub use instances::{EyeGrid, SceneAccel, SceneHit, TopLevel};
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};
 

@@ -3,7 +3,7 @@
 use glam::{Affine3A, Vec2, Vec3};
 
 use super::sampling::concentric_disk;
-use crate::accel::Ray;
+use crate::accel::{Ray, View};
 use crate::scene::{Camera, Motion, Projection, ThinLens};
 
 /// Generates the ray through a point of the image plane.
@@ -83,6 +83,43 @@ impl RayGenerator {
             (ndc.x + 1.0) * 0.5 * self.width as f32,
             (1.0 - ndc.y) * 0.5 * self.height as f32,
         )
+    }
+
+    /// What a grid of the eye ([`View`]) needs of a still pinhole camera: its eye, its frame
+    /// in the world, and the window of the plane one unit ahead that the image, grown by
+    /// `margin` pixels on every side, covers; `None` for a lens, an orthographic or a moving
+    /// camera, or a frame whose axes are not at right angles.
+    pub fn pinhole_view(&self, margin: f32, max_columns: u32) -> Option<View> {
+        if self.lens.is_some()
+            || self.motion.is_some()
+            || !matches!(self.projection, Projection::Perspective { .. })
+        {
+            return None;
+        }
+        let m = &self.world_from_camera;
+        let axes = [Vec3::X, Vec3::Y, Vec3::NEG_Z].map(|a| m.transform_vector3(a));
+        let [right, up, forward] = axes.map(Vec3::normalize_or_zero);
+        let square = |a: Vec3, b: Vec3| a.dot(b).abs() < 1e-6;
+        if !(square(right, up) && square(up, forward) && square(forward, right))
+            || [right, up, forward].contains(&Vec3::ZERO)
+        {
+            return None;
+        }
+        // A direction (x, y, −1) in the camera meets the plane at (x, y) scaled by the axes'
+        // lengths.
+        let scale = Vec2::new(axes[0].length(), axes[1].length()) / axes[2].length();
+        let per_pixel = 2.0 * self.half_extent / Vec2::new(self.width as f32, self.height as f32);
+        let half = (self.half_extent + margin * per_pixel) * scale;
+        Some(View {
+            // As the rays are made, so that their origins equal it.
+            eye: m.transform_point3(Vec3::ZERO),
+            right,
+            up,
+            forward,
+            lo: -half,
+            hi: half,
+            max_columns,
+        })
     }
 
     /// True when rays leave a lens of some size: each sample then needs a lens position.

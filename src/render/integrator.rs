@@ -15,7 +15,7 @@ use super::sampler::Sampler;
 use super::sampling::power_heuristic;
 use super::shading::Shading;
 use super::surface::{Surface, surface_at};
-use crate::accel::{Ray, SceneHit};
+use crate::accel::{EyeGrid, Ray, SceneHit};
 use crate::geometry::offset_ray_origin;
 
 /// How direct light is estimated. Only [`Strategy::Mis`] is meant for images; the other two
@@ -120,6 +120,9 @@ pub struct PathOptions<'a> {
     pub guiding: PathGuiding<'a>,
     /// How next-event estimates are taken.
     pub next_event: NextEvent<'a>,
+    /// The grid of the camera's eye, asked first for the path's first ray (the same answer
+    /// as the scene's grids, sooner).
+    pub eye: Option<&'a EyeGrid>,
 }
 
 impl PathOptions<'_> {
@@ -131,6 +134,7 @@ impl PathOptions<'_> {
             want_features: false,
             guiding: PathGuiding::Off,
             next_event: NextEvent::Always,
+            eye: None,
         }
     }
 }
@@ -369,7 +373,8 @@ impl Renderer<'_> {
         let mut path = Path::new(ray, options.want_features);
         loop {
             path.result.rays += 1;
-            let hit = self.accel.intersect(&path.ray);
+            let eye = options.eye.filter(|_| path.depth == 0);
+            let hit = self.accel.intersect_from(eye, &path.ray);
             self.add_sphere_lamps(&mut path, hit.as_ref(), strategy);
             let Some(hit) = hit else {
                 self.leave_scene(&mut path, strategy);

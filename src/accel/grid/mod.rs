@@ -99,6 +99,11 @@ impl Grid {
         self.frame.cell_size
     }
 
+    /// Triangles inserted (degenerate ones are left out).
+    pub fn triangles(&self) -> usize {
+        self.inserted
+    }
+
     /// Number of cells.
     fn cell_count(&self) -> usize {
         self.frame.cell_count()

@@ -10,8 +10,10 @@
 //! everything reads one word.
 //! The triangles are the grids' own (the numbers their blocks hold, tested by the same
 //! [`Block`] arithmetic), so a ray finds the hit the grids find: the same triangle, `t`,
-//! `u` and `v`, but for two triangles hit at exactly the same distance, where the order
-//! decides. Rays not from the eye or outside the window are the caller's to ask elsewhere.
+//! `u` and `v`. Where two triangles are hit at exactly the nearest distance (a ray through a
+//! shared edge) the order of testing would decide, so the view grid does not answer: such
+//! rays, rays not from the eye and rays outside the window are the caller's to ask of the
+//! grids, which makes every answer the grids' own by construction.
 
 use glam::{UVec2, Vec2, Vec3};
 use rayon::prelude::*;
@@ -186,18 +188,19 @@ impl ViewGrid {
     }
 
     /// The closest hit along `ray`: `Some(hit or none)` for a ray from the eye within the
-    /// window, `None` for any other ray, which the grid cannot answer.
+    /// window, `None` for any other ray and for a ray that meets two triangles at exactly
+    /// its nearest distance, which the grids answer instead.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Option<ViewHit>> {
         let column = self.column_of(ray)?;
-        Some(dispatch(
+        dispatch(
             X86Level::Avx512,
             ColumnIntersect {
                 grid: self,
                 ray,
                 column,
             },
-        ))
+        )
     }
 
     /// The column of a ray from the eye within the window, and the ray's speed ahead.
@@ -216,15 +219,27 @@ impl ViewGrid {
     }
 
     /// The nearest hit in column `column` (and the near list) of a ray whose speed ahead
-    /// is `w`.
+    /// is `w`: `Some(hit or none)`, or `None` when two triangles are hit at the nearest
+    /// distance.
     #[inline(always)]
-    fn nearest_in_column(&self, ray: &Ray, (column, w): (usize, f32)) -> Option<ViewHit> {
+    fn nearest_in_column(&self, ray: &Ray, (column, w): (usize, f32)) -> Option<Option<ViewHit>> {
         let mut best: Option<LaneHit> = None;
+        let mut tied = false;
         let mut t_max = ray.t_max;
         let mut test = |block: &Block, t_max: &mut f32| {
-            if let Some(hit) = block.nearest(ray, *t_max) {
-                *t_max = hit.t;
-                best = Some(hit);
+            // Hits at the nearest distance found so far count too: one of another triangle
+            // is a tie (a triangle of two columns may be met twice, in a block they share).
+            let limit = best.map_or(*t_max, |b| b.t.next_up());
+            match block.nearest_and_tie(ray, limit) {
+                Some((hit, tie)) if best.is_some_and(|b| b.t == hit.t) => {
+                    tied |= tie || best.is_some_and(|b| b.id != hit.id);
+                }
+                Some((hit, tie)) => {
+                    *t_max = hit.t;
+                    best = Some(hit);
+                    tied = tie;
+                }
+                None => {}
             }
         };
         for block in &self.near {
@@ -237,13 +252,17 @@ impl ViewGrid {
             false => lanes.start / LANES..lanes.end.div_ceil(LANES),
         };
         for (block, &depth) in self.blocks[range.clone()].iter().zip(&self.depths[range]) {
-            // Every later block's triangles lie at least this deep: past the hit found.
+            // Every later block's triangles lie at least this deep: past the hit found (a
+            // triangle hit at its distance lies no deeper, so ties are seen).
             if depth > t_max * w {
                 break;
             }
             test(block, &mut t_max);
         }
-        best.map(|hit| {
+        if tied {
+            return None;
+        }
+        Some(best.map(|hit| {
             let (source, triangle) = self.owners[hit.id as usize];
             ViewHit {
                 t: hit.t,
@@ -252,7 +271,7 @@ impl ViewGrid {
                 source,
                 triangle,
             }
-        })
+        }))
     }
 }
 
@@ -422,9 +441,9 @@ struct ColumnIntersect<'a> {
 }
 
 impl Kernel for ColumnIntersect<'_> {
-    type Output = Option<ViewHit>;
+    type Output = Option<Option<ViewHit>>;
     #[inline(always)]
-    fn run<const FUSED: bool>(self) -> Option<ViewHit> {
+    fn run<const FUSED: bool>(self) -> Option<Option<ViewHit>> {
         self.grid.nearest_in_column(self.ray, self.column)
     }
 }
@@ -455,8 +474,8 @@ mod tests {
         (best, tie)
     }
 
-    /// A mesh about an eye at the origin: small triangles ahead, some sharing edges, large
-    /// ones that pass beside and behind the eye, some wholly behind it.
+    /// A mesh about an eye at the origin: small triangles ahead, some sharing edges, some
+    /// doubled, large ones that pass beside and behind the eye, some wholly behind it.
     fn mesh_about_the_eye(rng: &mut Rng, count: usize) -> (Vec<Vec3>, Vec<[u32; 3]>) {
         let mut vertices = Vec::new();
         let mut indices = Vec::new();
@@ -465,6 +484,12 @@ mod tests {
             match k % 23 {
                 // Large, around the eye.
                 0 => (0..3).for_each(|_| vertices.push(random_vec(rng) * 6.0)),
+                // The last triangle again (a doubled face, as downloaded models have): every
+                // ray through it meets two triangles at one distance.
+                3 if n >= 3 => {
+                    indices.push(*indices.last().expect("a triangle before"));
+                    continue;
+                }
                 // Sharing an edge with the last triangle.
                 1 | 2 if n >= 3 => {
                     let last = vertices[n as usize - 1];
@@ -482,13 +507,15 @@ mod tests {
         (vertices, indices)
     }
 
-    /// Rays from the eye through the window find what testing every triangle finds: the
-    /// same triangle, `t`, `u` and `v` bit for bit (of two triangles at exactly the same
-    /// distance, either). Rays through triangles' edges and corners are among them.
+    /// Rays from the eye through the window find what testing every triangle finds, and what
+    /// the grid finds: the same triangle, `t`, `u` and `v` bit for bit; a ray that meets two
+    /// triangles at exactly its nearest distance, and only such a ray, is left to the grid.
+    /// Rays through triangles' edges and corners are among them.
     #[test]
     fn a_ray_from_the_eye_finds_what_testing_every_triangle_finds() {
         let mut rng = Rng::new(61, 2);
         let (mut hits, mut misses, mut answered, mut edge_hits) = (0, 0, 0, 0);
+        let mut declined_ties = 0;
         for scene in 0..40 {
             let (vertices, indices) = mesh_about_the_eye(&mut rng, 30 + 10 * scene);
             let triangles: Vec<Triangle> = (indices.iter())
@@ -499,6 +526,9 @@ mod tests {
                         vertices[c as usize],
                     )
                 })
+                .collect();
+            let doubled: Vec<usize> = (1..indices.len())
+                .filter(|&i| indices[i] == indices[i - 1])
                 .collect();
             let grid = Grid::from_mesh(vertices.clone(), &indices);
             let forward = random_vec(&mut rng).normalize();
@@ -523,6 +553,11 @@ mod tests {
                         t.v0 + a * t.e2,
                         t.v0 + t.e1 + a * (t.e2 - t.e1),
                     ][k / 4 % 3]
+                } else if k % 8 == 2 {
+                    // Through a point inside a doubled triangle.
+                    let t = &triangles[doubled[k / 8 % doubled.len()]];
+                    let (a, b) = (rng.uniform(), rng.uniform());
+                    t.v0 + 0.5 * a * t.e1 + 0.5 * b * t.e2
                 } else {
                     let p = view.lo + (view.hi - view.lo) * Vec2::new(rng.uniform(), rng.uniform());
                     (forward + p.x * view.right + p.y * view.up) * (0.5 + 2.0 * rng.uniform())
@@ -532,24 +567,26 @@ mod tests {
                     ..Ray::new(Vec3::ZERO, direction)
                 };
                 let (expected, tie) = nearest_of_every(&triangles, &ray);
+                let inside = view.on_plane(direction).is_some_and(|(p, _)| {
+                    p.cmpgt(view.lo + 1e-3).all() && p.cmplt(view.hi - 1e-3).all()
+                });
                 let Some(got) = view_grid.intersect(&ray) else {
-                    let inside = view.on_plane(direction).is_some_and(|(p, _)| {
-                        p.cmpgt(view.lo + 1e-3).all() && p.cmplt(view.hi - 1e-3).all()
-                    });
                     assert!(
-                        !inside,
-                        "scene {scene} ray {k}: a ray within the window is not answered"
+                        !inside || tie,
+                        "scene {scene} ray {k}: a ray within the window and without a tie is not answered"
                     );
+                    declined_ties += usize::from(inside);
                     continue;
                 };
+                assert!(!tie, "scene {scene} ray {k}: a tie answered");
                 answered += 1;
                 let got = got.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.triangle));
                 let want = expected.map(|e| (e.0.to_bits(), e.1.to_bits(), e.2.to_bits(), e.3));
-                if tie {
-                    assert_eq!(got.map(|g| g.0), want.map(|w| w.0), "scene {scene} ray {k}");
-                } else {
-                    assert_eq!(got, want, "scene {scene} ray {k}: {ray:?}");
-                }
+                assert_eq!(got, want, "scene {scene} ray {k}: {ray:?}");
+                let by_grid = grid.intersect(&ray);
+                let by_grid =
+                    by_grid.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.triangle));
+                assert_eq!(got, by_grid, "scene {scene} ray {k}: the grid's own answer");
                 hits += usize::from(want.is_some());
                 misses += usize::from(want.is_none());
                 edge_hits += usize::from(want.is_some() && k % 4 == 0);
@@ -562,9 +599,10 @@ mod tests {
             );
         }
         assert!(
-            answered > 12_000 && hits > 3_000 && misses > 3_000 && edge_hits > 300,
+            answered > 10_000 && hits > 3_000 && misses > 2_000 && edge_hits > 300,
             "{answered} answered, {hits} hits, {misses} misses, {edge_hits} on edges"
         );
+        assert!(declined_ties > 25, "{declined_ties} ties left to the grid");
     }
 
     /// The grid is the same built on one thread as on several.

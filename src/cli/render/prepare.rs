@@ -209,6 +209,7 @@ fn frame(
         time_limit: sampling.time_limit.map(Duration::from_secs_f64),
         guiding: guiding_for(sampling.guiding),
         next_event_roulette: sampling.next_event_roulette == Switch::On,
+        camera_grid: sampling.camera_grid == Switch::On,
     };
     Ok((camera, settings))
 }

@@ -70,6 +70,7 @@ impl Renderer<'_> {
                         want_features: false,
                         guiding: PathGuiding::Train(guide),
                         next_event,
+                        eye: None,
                     };
                     self.trace_path_with(ray, &mut sampler, options);
                 }

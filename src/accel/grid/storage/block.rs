@@ -154,6 +154,29 @@ impl Block {
     #[inline(always)]
     pub fn nearest(&self, ray: &Ray, t_max: f32) -> Option<LaneHit> {
         let (hit, ts, us, vs) = self.test(ray, t_max);
+        self.first_nearest(&hit, &ts, &us, &vs, t_max)
+    }
+
+    /// [`Block::nearest`], and whether a lane of another triangle is hit at exactly its
+    /// distance.
+    #[inline(always)]
+    pub fn nearest_and_tie(&self, ray: &Ray, t_max: f32) -> Option<(LaneHit, bool)> {
+        let (hit, ts, us, vs) = self.test(ray, t_max);
+        let best = self.first_nearest(&hit, &ts, &us, &vs, t_max)?;
+        let tie = (0..LANES).any(|l| hit[l] && ts[l] == best.t && self.ids[l] != best.id);
+        Some((best, tie))
+    }
+
+    /// The first of the nearest lanes hit, from [`Block::test`]'s answers.
+    #[inline(always)]
+    fn first_nearest(
+        &self,
+        hit: &[bool; LANES],
+        ts: &[f32; LANES],
+        us: &[f32; LANES],
+        vs: &[f32; LANES],
+        t_max: f32,
+    ) -> Option<LaneHit> {
         // Most blocks tested hold no hit: one test of all lanes then, not one per lane.
         if !hit.iter().any(|&h| h) {
             return None;
