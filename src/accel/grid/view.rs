@@ -225,25 +225,26 @@ impl ViewGrid {
     fn nearest_in_column(&self, ray: &Ray, (column, w): (usize, f32)) -> Option<Option<ViewHit>> {
         let mut best: Option<LaneHit> = None;
         let mut tied = false;
-        let mut t_max = ray.t_max;
-        let mut test = |block: &Block, t_max: &mut f32| {
-            // Hits at the nearest distance found so far count too: one of another triangle
-            // is a tie (a triangle of two columns may be met twice, in a block they share).
-            let limit = best.map_or(*t_max, |b| b.t.next_up());
-            match block.nearest_and_tie(ray, limit) {
-                Some((hit, tie)) if best.is_some_and(|b| b.t == hit.t) => {
-                    tied |= tie || best.is_some_and(|b| b.id != hit.id);
-                }
-                Some((hit, tie)) => {
-                    *t_max = hit.t;
+        // Hits below it count: before the ray's end, then up to and including the nearest
+        // found, so that a second triangle at its distance is seen.
+        let mut limit = ray.t_max;
+        let mut test = |block: &Block, limit: &mut f32| {
+            let Some((hit, tie)) = block.nearest_and_tie(ray, *limit) else {
+                return;
+            };
+            match best {
+                // The same triangle again is no tie: one in two columns may be met twice,
+                // in a block they share.
+                Some(b) if b.t == hit.t => tied |= tie || b.id != hit.id,
+                _ => {
+                    *limit = hit.t.next_up();
                     best = Some(hit);
                     tied = tie;
                 }
-                None => {}
             }
         };
         for block in &self.near {
-            test(block, &mut t_max);
+            test(block, &mut limit);
         }
         let lanes = self.starts[column] as usize..self.starts[column + 1] as usize;
         // An empty column tests nothing (not the block its place falls in).
@@ -254,10 +255,10 @@ impl ViewGrid {
         for (block, &depth) in self.blocks[range.clone()].iter().zip(&self.depths[range]) {
             // Every later block's triangles lie at least this deep: past the hit found (a
             // triangle hit at its distance lies no deeper, so ties are seen).
-            if depth > t_max * w {
+            if depth > limit * w {
                 break;
             }
-            test(block, &mut t_max);
+            test(block, &mut limit);
         }
         if tied {
             return None;
