@@ -11,6 +11,7 @@ mod camera;
 #[cfg(test)]
 mod chi_square;
 mod coverage;
+mod eye;
 mod film;
 mod filter;
 mod guiding;
@@ -39,23 +40,13 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-use crate::accel::{EyeGrid, Ray, SceneAccel, TopLevel};
+use crate::accel::{Ray, SceneAccel, TopLevel};
 use crate::scene::{Camera, Scene};
 use batches::{Batches, Bounds};
 use guiding::{Guide, guiding_at};
 use sampler::Sampler;
 use sampling::mix64;
 use surface::InstanceFrame;
-
-/// Camera rays per triangle from which a grid of the camera's eye is built. On the full
-/// dragon its build costs what about 14 camera rays per triangle save (docs/design/grid.md,
-/// "The grid of the camera's eye"); at 32 it saves about twice its cost.
-const EYE_GRID_RAYS_PER_TRIANGLE: u64 = 32;
-
-/// Triangles below which no grid of the eye is built: a few large triangles share few
-/// columns, each holding most of them (the Cornell box's camera rays took 1.4× as long
-/// through it; an 11,000-triangle dragon's 0.41×).
-const EYE_GRID_MIN_TRIANGLES: usize = 10_000;
 
 /// Samples per pixel when nothing says how many.
 pub const DEFAULT_SPP: u32 = 64;
@@ -372,24 +363,6 @@ impl<'a> Renderer<'a> {
             on_pass(stats.spp, &|| image_so_far(&film, stats));
         }
         image_so_far(&film, stats)
-    }
-
-    /// The grid of the camera's eye for a render of `settings`, when the scene has at least
-    /// [`EYE_GRID_MIN_TRIANGLES`], the image at least [`EYE_GRID_RAYS_PER_TRIANGLE`] camera
-    /// rays per triangle, and the camera is a still pinhole ([`RayGenerator::pinhole_view`],
-    /// [`SceneAccel::eye_grid`]): one column per pixel at most, the window grown by the
-    /// filter's width. What it answers, the scene's grids would answer alike.
-    pub fn eye_grid(&self, generator: &RayGenerator, settings: &RenderSettings) -> Option<EyeGrid> {
-        let triangles = self.accel.triangles();
-        let pixels = settings.width as u64 * settings.height as u64;
-        let camera_rays = pixels * settings.spp() as u64;
-        if triangles < EYE_GRID_MIN_TRIANGLES
-            || camera_rays < EYE_GRID_RAYS_PER_TRIANGLE * triangles as u64
-        {
-            return None;
-        }
-        let view = generator.pinhole_view(settings.filter_width, pixels.min(1 << 24) as u32)?;
-        self.accel.eye_grid(view)
     }
 
     /// Takes samples `samples` (with the seed before them) of every active pixel of `film`,
