@@ -13,10 +13,19 @@ use gridtrace::scene::{Camera, Environment, Scene};
 use oracles::{DRAGON_MODELS, dragon_path};
 use rayon::prelude::*;
 
-/// The scenes: every resolution of the dragon, and the bundled Cornell scenes.
+/// The scenes: every resolution of the dragon, the bundled Cornell scenes, and Blender
+/// exports whose cameras stand inside the scene (a room lit through a window, a room of
+/// lamps) or look at glass.
 fn scenes() -> Vec<(String, Scene)> {
     let dragons = DRAGON_MODELS.iter().map(|m| dragon_path(m));
-    let bundled = ["assets/cornell_box.glb", "assets/cornell_spheres.glb"].map(Into::into);
+    let bundled = [
+        "assets/cornell_box.glb",
+        "assets/cornell_spheres.glb",
+        "tests/data/scenes/window_room.glb",
+        "tests/data/scenes/lighting_room_lamps.usdc",
+        "tests/data/scenes/principled_glass.glb",
+    ]
+    .map(Into::into);
     (dragons.chain(bundled))
         .map(|path: std::path::PathBuf| {
             let scene = load_scene(&path).expect("the scene loads").scene;
